@@ -1,0 +1,36 @@
+"""Installs robostrich_suite (simulation) and agents (JAX SAC learner).
+
+Versions are pinned to a set that works together: mujoco 4.0 breaks
+dm-control 1.0.50 (see ../shared/design.md), and dm-haiku 0.0.17 is the
+last haiku release, tested here with jax 0.10.2.
+"""
+from setuptools import find_packages, setup
+
+setup(
+    name="robostrich_suite",
+    version="0.1.0",
+    description="Simulation and curriculum-SAC learning for the tendon-driven Robostrich arm.",
+    python_requires=">=3.10",
+    packages=find_packages(include=["robostrich_suite", "robostrich_suite.*", "agents", "agents.*"]),
+    package_data={"robostrich_suite": ["data/*"]},
+    install_requires=[
+        "mujoco==3.17.0",
+        "dm-control==1.0.50",
+        "dm-env==1.6",
+        "numpy==2.4.6",
+        "jax==0.10.2",
+        "jaxlib==0.10.2",
+        "dm-haiku==0.0.17",
+        "optax==0.2.8",
+        "rerun-sdk==0.41.0",
+        "matplotlib==3.11.2",  # figures (PNG) for the paper's plots
+        "tqdm==4.70.1",  # progress bars on training and sampling
+    ],
+    extras_require={
+        "test": ["pytest==9.2.0", "pytest-xdist==3.8.0"],
+        "gym": ["gymnasium==1.4.0"],
+    },
+    entry_points={
+        "console_scripts": [],
+    },
+)
