@@ -1,0 +1,76 @@
+"""A generic actor: flattened observation in, environment action out.
+
+The policy network works in [-1, 1]^|A|; `ActionAdapter` maps that box onto
+the BoundedArray spec (e.g. tendon contractions in metres) and back.
+"""
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from agents.sac.networks import SACNetworks
+
+
+class ActionAdapter:
+    """Affine map between the policy's [-1, 1] box and the environment's bounds."""
+
+    def __init__(self, action_spec):
+        shape = action_spec.shape
+        if not hasattr(action_spec, "minimum") or not hasattr(action_spec, "maximum"):
+            raise ValueError("the action spec must be a BoundedArray with minimum and maximum")
+        self.low = np.broadcast_to(np.asarray(action_spec.minimum, np.float64), shape).copy()
+        self.high = np.broadcast_to(np.asarray(action_spec.maximum, np.float64), shape).copy()
+        if not (np.all(np.isfinite(self.low)) and np.all(np.isfinite(self.high)) and np.all(self.high > self.low)):
+            raise ValueError(f"action bounds must be finite with maximum > minimum, got {self.low} .. {self.high}")
+        self.dtype = action_spec.dtype
+        self.size = int(np.prod(shape))
+        self._half_range = 0.5 * (self.high - self.low)
+        self._mid = 0.5 * (self.high + self.low)
+
+    def to_env(self, policy_action) -> np.ndarray:
+        return (self._mid + self._half_range * np.asarray(policy_action, np.float64)).astype(self.dtype)
+
+    def to_policy(self, env_action) -> np.ndarray:
+        return ((np.asarray(env_action, np.float64) - self._mid) / self._half_range).astype(np.float32)
+
+
+class Actor:
+    """Runs the policy for one observation per call.
+
+    Stochastic (`deterministic=False`) samples a ~ pi(.|s) for training;
+    deterministic returns tanh(mean) for evaluation. The sampling key is
+    carried inside the jitted call, so a step costs one dispatch.
+    """
+
+    def __init__(self, networks: SACNetworks, adapter: ActionAdapter, params, key=None, deterministic=False):
+        self.adapter = adapter
+        self.params = params
+        self.deterministic = deterministic
+        self.key = jax.random.PRNGKey(0) if key is None else key
+
+        def stochastic(params, obs, key):
+            key, sample_key = jax.random.split(key)
+            action, _ = networks.sample(params, obs[None], sample_key)
+            return action[0], key
+
+        def mode(params, obs):
+            return networks.mode(params, obs[None])[0]
+
+        self._stochastic = jax.jit(stochastic)
+        self._mode = jax.jit(mode)
+
+    def update(self, params):
+        self.params = params
+
+    def policy_action(self, flat_obs: np.ndarray) -> np.ndarray:
+        """Action in [-1, 1]; raises if the network produced NaN/inf."""
+        if self.deterministic:
+            action = self._mode(self.params, flat_obs)
+        else:
+            action, self.key = self._stochastic(self.params, flat_obs, self.key)
+        action = np.asarray(action)
+        if not np.all(np.isfinite(action)):
+            raise ValueError(f"policy produced a non-finite action {action}; observation was {flat_obs}")
+        return action
+
+    def select_action(self, flat_obs: np.ndarray) -> np.ndarray:
+        return self.adapter.to_env(self.policy_action(flat_obs))

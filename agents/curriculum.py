@@ -1,0 +1,212 @@
+"""The curriculum (Algorithm 1): one agent goes through a list of lessons.
+
+Parameters, optimiser states, temperature and replay are never reset between
+lessons; only the environment is swapped. A plain-SAC baseline is the same
+runner with a one-lesson plan.
+"""
+import dataclasses
+import json
+import os
+import pickle
+import zlib
+from typing import Callable, List, Optional, Sequence
+
+import numpy as np
+
+from agents import checkpoint
+from agents.sac.builder import SACBuilder
+from agents.sac.config import SACConfig
+
+ROBOSTRICH_DOMAINS = ("robostrich",)
+
+
+@dataclasses.dataclass(frozen=True)
+class Lesson:
+    domain: str
+    task: str
+    steps: int
+
+
+def parse_plan(text: str, default_domain: str = "robostrich") -> List[Lesson]:
+    """'lesson1:50000,lesson2:50000' or 'point_mass/easy:2000' -> [Lesson, ...]."""
+    lessons = []
+    for item in filter(None, (s.strip() for s in text.split(","))):
+        try:
+            name, steps = item.rsplit(":", 1)
+            steps = int(float(steps))
+        except ValueError:
+            raise ValueError(f"bad lesson {item!r}: expected [domain/]task:steps") from None
+        domain, task = name.split("/", 1) if "/" in name else (default_domain, name)
+        if steps <= 0:
+            raise ValueError(f"lesson {item!r} has a non-positive step budget")
+        lessons.append(Lesson(domain, task, steps))
+    if not lessons:
+        raise ValueError("empty lesson plan")
+    return lessons
+
+
+def format_plan(plan: Sequence[Lesson]) -> str:
+    return ",".join(f"{l.domain}/{l.task}:{l.steps}" for l in plan)
+
+
+def make_environment(domain: str, task: str, seed: int, **task_kwargs):
+    """robostrich_suite.load for the arm, dm_control.suite.load otherwise (used in development and tests)."""
+    task_kwargs = {"random": seed, **task_kwargs}
+    if domain in ROBOSTRICH_DOMAINS:
+        import robostrich_suite
+        return robostrich_suite.load(domain, task, task_kwargs=task_kwargs)
+    from dm_control import suite
+    return suite.load(domain, task, task_kwargs=task_kwargs)
+
+
+class TrainingInterrupted(RuntimeError):
+    """Raised by `stop_at_step` to imitate a killed process in tests."""
+
+
+class CurriculumRun:
+    """A learner, its replay and its position in a lesson plan, with checkpoints.
+
+    Checkpoints hold the learner state (parameters, optimiser states,
+    temperature, update counter, RNG key), the actor's key, the replay buffer
+    (filled part) and its sampling RNG, the loop counters, the lesson index and
+    steps into it, and the pickled environment (physics, task RNG and any task
+    state, e.g. lesson 3's carried-over pose), so a resumed run continues
+    bit-exactly, even mid-episode.
+    """
+
+    def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
+                 checkpoint_every: int = 10_000, env_factory: Callable = make_environment, name: str = "run"):
+        self.plan = list(plan)
+        self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
+        self.checkpoint_every = int(checkpoint_every)
+        self.env_factory = env_factory
+        self.lesson_index = 0
+        self.lesson_steps = 0
+        os.makedirs(run_dir, exist_ok=True)
+        self.loop = SACBuilder(config).make_components(self._make_lesson_env(0), seed)
+        self.checkpoint_path = os.path.join(run_dir, "checkpoint.pkl")
+        self.metrics_path = os.path.join(run_dir, "metrics.jsonl")
+        self.evals_path = os.path.join(run_dir, "evals.jsonl")
+
+    # -- lessons ---------------------------------------------------------------------------
+    def _make_lesson_env(self, index):
+        lesson = self.plan[index]
+        return self.env_factory(lesson.domain, lesson.task, self.seed + 1000 * (index + 1))
+
+    @property
+    def total_steps(self) -> int:
+        return sum(l.steps for l in self.plan)
+
+    @property
+    def lesson(self) -> Lesson:
+        return self.plan[min(self.lesson_index, len(self.plan) - 1)]
+
+    @property
+    def done(self) -> bool:
+        return self.lesson_index >= len(self.plan)
+
+    def lesson_boundaries(self) -> List[int]:
+        return list(np.cumsum([l.steps for l in self.plan]))
+
+    # -- checkpoints -----------------------------------------------------------------------
+    def fingerprint(self) -> dict:
+        return {"config": self.config.to_dict(), "plan": format_plan(self.plan), "seed": self.seed,
+                "observation_layout": self.loop.flattener.describe(), "action_size": self.loop.actor.adapter.size}
+
+    def state_dict(self) -> dict:
+        loop = self.loop
+        env_blob = None
+        try:
+            env_blob = zlib.compress(pickle.dumps((loop.env, loop.timestep, loop._obs), pickle.HIGHEST_PROTOCOL), 1)
+        except Exception as e:  # documented fallback: resume then resets the episode
+            env_blob = None
+            print(f"warning: environment is not picklable ({e}); a resume will start a fresh episode")
+        return {
+            "learner": loop.learner.get_state(),
+            "actor_key": np.asarray(loop.actor.key),
+            "replay": loop.replay.state_dict(),
+            "loop": loop.state_dict(),
+            "lesson_index": self.lesson_index,
+            "lesson_steps": self.lesson_steps,
+            "environment": env_blob,
+            "latest_metrics": loop.metrics_as_floats(),
+        }
+
+    def save_checkpoint(self, path: Optional[str] = None):
+        checkpoint.save(path or self.checkpoint_path, self.state_dict(), self.fingerprint())
+
+    def restore(self, path: Optional[str] = None):
+        path = path or self.checkpoint_path
+        state = checkpoint.load(path, self.fingerprint())
+        loop = self.loop
+        loop.learner.set_state(state["learner"])
+        loop.actor.update(loop.learner.policy_params)
+        loop.actor.key = np.asarray(state["actor_key"])
+        loop.replay.load_state_dict(state["replay"])
+        self.lesson_index, self.lesson_steps = state["lesson_index"], state["lesson_steps"]
+        if state["environment"] is not None:
+            env, timestep, obs = pickle.loads(zlib.decompress(state["environment"]))
+            loop.set_environment(env)
+            loop.timestep, loop._obs = timestep, obs
+        elif not self.done:
+            loop.set_environment(self._make_lesson_env(self.lesson_index))
+        loop.load_state_dict(state["loop"])
+        loop.latest_metrics = state.get("latest_metrics", {})
+        for p in (self.metrics_path, self.evals_path):  # drop records written after the checkpoint
+            _truncate_jsonl(p, loop.env_steps)
+
+    # -- Algorithm 1 -----------------------------------------------------------------------
+    def run(self, progress=None, on_eval: Optional[Callable] = None, eval_at: Sequence[int] = (),
+            stop_at_step: Optional[int] = None, chunk: int = 500):
+        """Run the remaining plan. `on_eval(run)` is called when env_steps hits a value in eval_at."""
+        loop = self.loop
+        eval_at = sorted(set(int(s) for s in eval_at))
+        metrics_file = open(self.metrics_path, "a")
+
+        def on_episode(record):
+            record.update(lesson=self.lesson_index + 1, task=self.lesson.task, run=self.name,
+                          updates=loop.learner.num_updates, **loop.metrics_as_floats())
+            metrics_file.write(json.dumps(record) + "\n")
+            if progress is not None:
+                progress.on_episode(record)
+
+        try:
+            while not self.done:
+                lesson = self.plan[self.lesson_index]
+                n = min(chunk, lesson.steps - self.lesson_steps)
+                n = min(n, self.checkpoint_every - loop.env_steps % self.checkpoint_every)
+                upcoming = [s for s in eval_at if s > loop.env_steps]
+                if upcoming:
+                    n = min(n, upcoming[0] - loop.env_steps)
+                if stop_at_step is not None:
+                    if loop.env_steps >= stop_at_step:
+                        raise TrainingInterrupted(f"stopped at step {loop.env_steps}")
+                    n = min(n, stop_at_step - loop.env_steps)
+                loop.run(n, on_episode=on_episode)
+                self.lesson_steps += n
+                if progress is not None:
+                    progress.update(n, self)
+                if self.lesson_steps >= lesson.steps:  # next lesson; everything else carries over
+                    self.lesson_index += 1
+                    self.lesson_steps = 0
+                    if not self.done:
+                        loop.set_environment(self._make_lesson_env(self.lesson_index))
+                if on_eval is not None and loop.env_steps in eval_at:
+                    metrics_file.flush()
+                    on_eval(self)
+                if loop.env_steps % self.checkpoint_every == 0 or self.done:
+                    metrics_file.flush()
+                    self.save_checkpoint()
+        finally:
+            metrics_file.close()
+
+
+def _truncate_jsonl(path: str, max_env_steps: int):
+    if not os.path.exists(path):
+        return
+    with open(path) as f:
+        lines = [l for l in f if l.strip()]
+    kept = [l for l in lines if json.loads(l).get("env_steps", 0) <= max_env_steps]
+    if len(kept) != len(lines):
+        with open(path, "w") as f:
+            f.writelines(kept)

@@ -1,0 +1,98 @@
+"""EnvironmentLoop: acts, stores transitions, and calls the learner every few steps.
+
+Per environment step the Python work is: one jitted policy call, env.step,
+one flatten and one row insert. The learner is called once per
+`config.env_steps_per_call` steps with a whole stack of batches.
+"""
+import time
+from typing import Callable, Optional
+
+import numpy as np
+
+from agents import probes
+from agents.actors import Actor
+from agents.replay import ObservationFlattener, ReplayBuffer
+from agents.sac.config import SACConfig
+from agents.sac.learning import SACLearner
+
+
+class EnvironmentLoop:
+    def __init__(self, env, actor: Actor, replay: ReplayBuffer, learner: SACLearner, config: SACConfig,
+                 flattener: ObservationFlattener, seed: int = 0, label: str = ""):
+        self.actor, self.replay, self.learner, self.config = actor, replay, learner, config
+        self.flattener = flattener
+        self.label = label
+        self.env_steps = 0  # all environment steps in this run (across lessons)
+        self.episodes = 0
+        self.warmup_rng = np.random.default_rng(seed + 7919)  # uniform actions before min_replay
+        self.latest_metrics = {}
+        self._set_env(env)
+
+    def _set_env(self, env):
+        self.env = env
+        self.timestep = None  # reset lazily: a checkpointed env resumes mid-episode
+        self.episode_return = 0.0
+        self.episode_length = 0
+        self._obs = None
+
+    def set_environment(self, env):
+        """Switch lesson: the learner, actor and replay carry over (Algorithm 1)."""
+        self._set_env(env)
+
+    def _act(self, flat_obs):
+        if len(self.replay) < self.config.min_replay_size:
+            policy_action = self.warmup_rng.uniform(-1.0, 1.0, self.actor.adapter.size).astype(np.float32)
+        else:
+            policy_action = self.actor.policy_action(flat_obs)
+        return policy_action
+
+    def run(self, num_steps: int, on_episode: Optional[Callable] = None,
+            on_step: Optional[Callable] = None) -> None:
+        """Run exactly num_steps environment steps (episodes may straddle calls)."""
+        env, replay, adapter, flatten = self.env, self.replay, self.actor.adapter, self.flattener
+        cfg = self.config
+        for _ in range(num_steps):
+            if self.timestep is None or self.timestep.last():
+                self.timestep = env.reset()
+                self._obs = flatten(self.timestep.observation)
+                self.episode_return, self.episode_length = 0.0, 0
+            obs = self._obs
+            policy_action = self._act(obs)
+            timestep = env.step(adapter.to_env(policy_action))
+            next_obs = flatten(timestep.observation)
+            reward = float(timestep.reward)
+            replay.add(obs, policy_action, reward, float(timestep.discount), next_obs)
+            self.timestep, self._obs = timestep, next_obs
+            self.episode_return += reward
+            self.episode_length += 1
+            self.env_steps += 1
+            if self.env_steps % cfg.env_steps_per_call == 0 and len(replay) >= cfg.min_replay_size:
+                batches = replay.sample_stack(cfg.updates_per_call, cfg.batch_size)
+                self.latest_metrics = self.learner.step(batches)
+                self.actor.update(self.learner.policy_params)
+            if timestep.last():
+                self.episodes += 1
+                if on_episode is not None:
+                    position_error, attitude_error = probes.head_errors(env)
+                    on_episode({
+                        "env_steps": self.env_steps, "episode": self.episodes,
+                        "return": self.episode_return, "length": self.episode_length,
+                        "position_error": position_error, "attitude_error": attitude_error,
+                        "success": probes.is_success(position_error, attitude_error),
+                        "time": time.time(),
+                    })
+            if on_step is not None:
+                on_step(self)
+
+    def metrics_as_floats(self) -> dict:
+        return {k: float(v) for k, v in self.latest_metrics.items()}
+
+    def state_dict(self) -> dict:
+        return {"env_steps": self.env_steps, "episodes": self.episodes,
+                "warmup_rng": self.warmup_rng.bit_generator.state,
+                "episode_return": self.episode_return, "episode_length": self.episode_length}
+
+    def load_state_dict(self, d: dict):
+        self.env_steps, self.episodes = d["env_steps"], d["episodes"]
+        self.warmup_rng.bit_generator.state = d["warmup_rng"]
+        self.episode_return, self.episode_length = d["episode_return"], d["episode_length"]

@@ -1,0 +1,61 @@
+"""Hyperparameters of the SAC agent (Acme's defaults unless noted)."""
+import dataclasses
+from typing import Optional, Tuple
+
+
+@dataclasses.dataclass(frozen=True)
+class SACConfig:
+    """Everything that changes what the agent computes.
+
+    Fields that change the learning dynamics are part of the checkpoint
+    fingerprint, so a checkpoint is never resumed under different settings.
+    """
+
+    batch_size: int = 256
+    learning_rate: float = 3e-4  # critics, actor and temperature alike
+    discount: float = 0.99
+    tau: float = 0.005  # Polyak rate of the target critics
+    target_entropy: Optional[float] = None  # None -> -|A| (Acme)
+    init_temperature: float = 1.0
+    hidden_sizes: Tuple[int, ...] = (256, 256)
+    min_replay_size: int = 10_000
+    max_replay_size: int = 1_000_000
+    # The learner runs `updates_per_call` gradient steps (one lax.scan) every
+    # `env_steps_per_call` environment steps: update-to-data ratio = their quotient.
+    updates_per_call: int = 8
+    env_steps_per_call: int = 8
+    reward_scale: float = 1.0
+    log_std_min: float = -5.0
+    log_std_max: float = 2.0
+
+    def __post_init__(self):
+        if self.batch_size <= 0 or self.updates_per_call <= 0 or self.env_steps_per_call <= 0:
+            raise ValueError("batch_size, updates_per_call and env_steps_per_call must be positive")
+        if not 0.0 < self.tau <= 1.0:
+            raise ValueError(f"tau must be in (0, 1], got {self.tau}")
+        if self.min_replay_size > self.max_replay_size:
+            raise ValueError("min_replay_size exceeds max_replay_size")
+        object.__setattr__(self, "hidden_sizes", tuple(int(h) for h in self.hidden_sizes))
+
+    @property
+    def update_to_data_ratio(self) -> float:
+        return self.updates_per_call / self.env_steps_per_call
+
+    def resolved_target_entropy(self, action_size: int) -> float:
+        return -float(action_size) if self.target_entropy is None else float(self.target_entropy)
+
+    def to_dict(self) -> dict:
+        d = dataclasses.asdict(self)
+        d["hidden_sizes"] = list(self.hidden_sizes)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "SACConfig":
+        fields = {f.name for f in dataclasses.fields(cls)}
+        unknown = set(d) - fields
+        if unknown:
+            raise ValueError(f"unknown SACConfig fields: {sorted(unknown)}")
+        d = dict(d)
+        if "hidden_sizes" in d:
+            d["hidden_sizes"] = tuple(d["hidden_sizes"])
+        return cls(**d)

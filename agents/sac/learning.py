@@ -1,0 +1,155 @@
+"""The SAC learner: critics, actor, temperature and Polyak targets in one jitted function.
+
+`SACLearner.step(batches)` runs `batches.reward.shape[0]` updates inside a
+single `lax.scan`, so Python is entered once per call, not once per update.
+"""
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+
+from agents.sac.config import SACConfig
+from agents.sac.networks import SACNetworks
+
+
+class Transitions(NamedTuple):
+    """A batch of (s, a, r, discount, s'); `action` is in the policy's [-1, 1] space."""
+
+    obs: jnp.ndarray
+    action: jnp.ndarray
+    reward: jnp.ndarray
+    discount: jnp.ndarray
+    next_obs: jnp.ndarray
+
+
+class TrainingState(NamedTuple):
+    policy_params: dict
+    q_params: dict
+    target_q_params: dict
+    policy_opt_state: tuple
+    q_opt_state: tuple
+    log_alpha: jnp.ndarray
+    alpha_opt_state: tuple
+    key: jnp.ndarray
+    steps: jnp.ndarray  # number of gradient updates done
+
+
+def make_optimizers(config: SACConfig):
+    """One Adam per parameter group, as in Algorithm 1 (lambda_Q, lambda_pi, lambda_alpha)."""
+    return (optax.adam(config.learning_rate), optax.adam(config.learning_rate),
+            optax.adam(config.learning_rate))
+
+
+def init_state(networks: SACNetworks, config: SACConfig, key) -> TrainingState:
+    policy_opt, q_opt, alpha_opt = make_optimizers(config)
+    key, k_pi, k_q = jax.random.split(key, 3)
+    policy_params = networks.policy_init(k_pi)
+    q_params = networks.q_init(k_q)
+    log_alpha = jnp.asarray(np.log(config.init_temperature), jnp.float32)
+    return TrainingState(
+        policy_params=policy_params,
+        q_params=q_params,
+        target_q_params=jax.tree_util.tree_map(jnp.copy, q_params),
+        policy_opt_state=policy_opt.init(policy_params),
+        q_opt_state=q_opt.init(q_params),
+        log_alpha=log_alpha,
+        alpha_opt_state=alpha_opt.init(log_alpha),
+        key=key,
+        steps=jnp.zeros((), jnp.int32),
+    )
+
+
+def make_update_fn(networks: SACNetworks, config: SACConfig):
+    """Returns update(state, batch) -> (state, metrics) for ONE gradient step (not jitted)."""
+    policy_opt, q_opt, alpha_opt = make_optimizers(config)
+    target_entropy = config.resolved_target_entropy(networks.action_size)
+
+    def critic_loss(q_params, target_q_params, policy_params, alpha, batch, key):
+        next_action, next_log_prob = networks.sample(policy_params, batch.next_obs, key)
+        tq1, tq2 = networks.q_apply(target_q_params, batch.next_obs, next_action)
+        next_v = jnp.minimum(tq1, tq2) - alpha * next_log_prob  # soft V (eq. 3)
+        target = config.reward_scale * batch.reward + config.discount * batch.discount * next_v
+        target = jax.lax.stop_gradient(target)
+        q1, q2 = networks.q_apply(q_params, batch.obs, batch.action)
+        loss = 0.5 * (jnp.mean((q1 - target) ** 2) + jnp.mean((q2 - target) ** 2))  # eq. 6
+        return loss, jnp.mean(q1)
+
+    def actor_loss(policy_params, q_params, alpha, obs, key):
+        action, log_prob = networks.sample(policy_params, obs, key)
+        q1, q2 = networks.q_apply(q_params, obs, action)
+        return jnp.mean(alpha * log_prob - jnp.minimum(q1, q2)), log_prob  # eq. 7
+
+    def alpha_loss(log_alpha, log_prob):
+        # eq. 8: raise alpha when the entropy -log_prob falls below the target.
+        return jnp.mean(-jnp.exp(log_alpha) * jax.lax.stop_gradient(log_prob + target_entropy))
+
+    def update(state: TrainingState, batch: Transitions):
+        key, k_critic, k_actor = jax.random.split(state.key, 3)
+        alpha = jnp.exp(state.log_alpha)
+
+        (c_loss, q_mean), q_grads = jax.value_and_grad(critic_loss, has_aux=True)(
+            state.q_params, state.target_q_params, state.policy_params, alpha, batch, k_critic)
+        q_updates, q_opt_state = q_opt.update(q_grads, state.q_opt_state, state.q_params)
+        q_params = optax.apply_updates(state.q_params, q_updates)
+
+        (a_loss, log_prob), pi_grads = jax.value_and_grad(actor_loss, has_aux=True)(
+            state.policy_params, q_params, alpha, batch.obs, k_actor)
+        pi_updates, policy_opt_state = policy_opt.update(pi_grads, state.policy_opt_state, state.policy_params)
+        policy_params = optax.apply_updates(state.policy_params, pi_updates)
+
+        t_loss, alpha_grad = jax.value_and_grad(alpha_loss)(state.log_alpha, log_prob)
+        alpha_updates, alpha_opt_state = alpha_opt.update(alpha_grad, state.alpha_opt_state, state.log_alpha)
+        log_alpha = optax.apply_updates(state.log_alpha, alpha_updates)
+
+        target_q_params = optax.incremental_update(q_params, state.target_q_params, config.tau)
+        new_state = TrainingState(policy_params, q_params, target_q_params, policy_opt_state, q_opt_state,
+                                  log_alpha, alpha_opt_state, key, state.steps + 1)
+        metrics = {"critic_loss": c_loss, "actor_loss": a_loss, "alpha_loss": t_loss,
+                   "temperature": alpha, "entropy": -jnp.mean(log_prob), "q_mean": q_mean}
+        return new_state, metrics
+
+    return update
+
+
+class SACLearner:
+    """Holds the training state; `step` runs a stack of updates in one jitted call."""
+
+    def __init__(self, networks: SACNetworks, config: SACConfig, key):
+        self.networks = networks
+        self.config = config
+        update = make_update_fn(networks, config)
+
+        def update_many(state, batches):
+            state, metrics = jax.lax.scan(update, state, batches)
+            return state, jax.tree_util.tree_map(jnp.mean, metrics)
+
+        self._update_many = jax.jit(update_many)
+        self.state = init_state(networks, config, key)
+
+    def step(self, batches: Transitions) -> dict:
+        """batches: arrays with a leading [num_updates, batch_size] shape. Returns mean metrics (floats)."""
+        self.state, metrics = self._update_many(self.state, batches)
+        return metrics
+
+    @property
+    def policy_params(self):
+        return self.state.policy_params
+
+    @property
+    def num_updates(self) -> int:
+        return int(self.state.steps)
+
+    def get_state(self):
+        """Numpy copy of the full state, for checkpoints."""
+        return jax.tree_util.tree_map(np.asarray, self.state)
+
+    def set_state(self, state):
+        ref = jax.tree_util.tree_structure(self.state)
+        if jax.tree_util.tree_structure(state) != ref:
+            raise ValueError("learner state in checkpoint does not match this learner's structure")
+        for a, b in zip(jax.tree_util.tree_leaves(self.state), jax.tree_util.tree_leaves(state)):
+            if np.shape(a) != np.shape(b):
+                raise ValueError(f"learner state shape mismatch: {np.shape(b)} in checkpoint, {np.shape(a)} expected")
+        self.state = jax.tree_util.tree_map(jnp.asarray, state)

@@ -1,0 +1,77 @@
+"""Haiku networks of SAC: a tanh-Gaussian policy and twin Q critics.
+
+The policy acts in [-1, 1]^|A|; mapping to the environment's bounds is the
+actor's job (agents/actors.py), so the networks never see physical units.
+"""
+import dataclasses
+from typing import Callable, Sequence
+
+import haiku as hk
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+_LOG_2 = float(np.log(2.0))
+
+
+@dataclasses.dataclass(frozen=True)
+class SACNetworks:
+    """Pure functions plus initialisers; parameters live in the learner's state."""
+
+    policy_init: Callable
+    policy_apply: Callable  # (params, obs) -> (mean, log_std)
+    q_init: Callable
+    q_apply: Callable  # (params, obs, action) -> (q1, q2), each shape [B]
+    obs_size: int
+    action_size: int
+
+    def sample(self, params, obs, key):
+        """Reparameterised sample a = tanh(u) and its log-probability (eq. 7)."""
+        mean, log_std = self.policy_apply(params, obs)
+        u = mean + jnp.exp(log_std) * jax.random.normal(key, mean.shape, mean.dtype)
+        return jnp.tanh(u), tanh_gaussian_log_prob(u, mean, log_std)
+
+    def mode(self, params, obs):
+        """Deterministic action used in evaluation."""
+        mean, _ = self.policy_apply(params, obs)
+        return jnp.tanh(mean)
+
+
+def tanh_gaussian_log_prob(u, mean, log_std):
+    """log pi(tanh(u)); the Jacobian term uses log(1 - tanh^2 u) = 2(log2 - u - softplus(-2u)), stable for large |u|."""
+    z = (u - mean) * jnp.exp(-log_std)
+    gaussian = -0.5 * z ** 2 - log_std - 0.5 * jnp.log(2.0 * jnp.pi)
+    log_det = 2.0 * (_LOG_2 - u - jax.nn.softplus(-2.0 * u))
+    return jnp.sum(gaussian - log_det, axis=-1)
+
+
+def make_networks(obs_size: int, action_size: int, hidden_sizes: Sequence[int] = (256, 256),
+                  log_std_min: float = -5.0, log_std_max: float = 2.0) -> SACNetworks:
+    hidden_sizes = tuple(hidden_sizes)
+
+    def policy_fn(obs):
+        h = hk.nets.MLP(hidden_sizes, activation=jax.nn.relu, activate_final=True, name="policy_torso")(obs)
+        mean = hk.Linear(action_size, name="mean")(h)
+        raw = hk.Linear(action_size, name="log_std")(h)
+        # Squash log_std smoothly into its range (as CleanRL) rather than clipping away the gradient.
+        log_std = log_std_min + 0.5 * (log_std_max - log_std_min) * (jnp.tanh(raw) + 1.0)
+        return mean, log_std
+
+    def q_fn(obs, action):
+        x = jnp.concatenate([obs, action], axis=-1)
+        q1 = hk.nets.MLP(hidden_sizes + (1,), activation=jax.nn.relu, name="q1")(x)
+        q2 = hk.nets.MLP(hidden_sizes + (1,), activation=jax.nn.relu, name="q2")(x)
+        return q1[..., 0], q2[..., 0]
+
+    policy = hk.without_apply_rng(hk.transform(policy_fn))
+    q = hk.without_apply_rng(hk.transform(q_fn))
+    dummy_obs = jnp.zeros((1, obs_size), jnp.float32)
+    dummy_act = jnp.zeros((1, action_size), jnp.float32)
+    return SACNetworks(
+        policy_init=lambda key: policy.init(key, dummy_obs),
+        policy_apply=policy.apply,
+        q_init=lambda key: q.init(key, dummy_obs, dummy_act),
+        q_apply=q.apply,
+        obs_size=obs_size,
+        action_size=action_size,
+    )
