@@ -1,0 +1,192 @@
+"""Evaluation of the deterministic policy: held-out targets and the three-target `track` task (Fig. 7).
+
+Writes one JSON report per evaluation. `main` (console command
+`robostrich-evaluate`) loads a checkpoint and writes the same reports,
+figures and Rerun recordings as the end of a training run.
+"""
+import argparse
+import json
+import os
+from typing import Optional
+
+import numpy as np
+
+from agents import probes
+from agents.curriculum import ROBOSTRICH_DOMAINS, make_environment
+
+
+def rollout(env, actor, flattener, recorder=None) -> dict:
+    """One episode with `actor`; per-step series of errors, head pose, target and action."""
+    timestep = env.reset()
+    physics = env.physics
+    has_head = hasattr(physics, "head_position")
+    series = {k: [] for k in ("time", "position_error", "attitude_error", "head_position", "head_attitude",
+                              "target", "action", "reward")}
+    if recorder is not None:
+        recorder.log_step(env, None, timestep)
+    while not timestep.last():
+        action = actor.select_action(flattener(timestep.observation))
+        timestep = env.step(action)
+        position_error, attitude_error = probes.head_errors(env)
+        series["time"].append(float(physics.data.time))
+        series["position_error"].append(position_error)
+        series["attitude_error"].append(attitude_error)
+        series["reward"].append(float(timestep.reward))
+        series["action"].append(np.asarray(action, np.float64).tolist())
+        if has_head:
+            series["head_position"].append(np.asarray(physics.head_position(), np.float64).tolist())
+            series["head_attitude"].append(float(physics.head_attitude()))
+            series["target"].append(np.asarray(env.task.target_position, np.float64).tolist())
+        if recorder is not None:
+            recorder.log_step(env, action, timestep, position_error, attitude_error)
+    return series
+
+
+def _episode_summary(series, start=0, end=None) -> dict:
+    pe = np.asarray(series["position_error"][start:end])
+    ae = np.asarray(series["attitude_error"][start:end])
+    within = (pe <= probes.POSITION_TOLERANCE) & (ae <= probes.ATTITUDE_TOLERANCE)
+    reached = np.flatnonzero(within)
+    return {
+        "final_position_error": float(pe[-1]), "final_attitude_error": float(ae[-1]),
+        "min_position_error": float(pe.min()),
+        "success": probes.is_success(pe[-1], ae[-1]),
+        "steps_to_reach": int(reached[0] + 1) if reached.size else None,
+        "steps": int(pe.size),
+    }
+
+
+def summarize(episodes) -> dict:
+    pe = np.array([e["final_position_error"] for e in episodes])
+    ae = np.array([e["final_attitude_error"] for e in episodes])
+    reach = [e["steps_to_reach"] for e in episodes if e["steps_to_reach"] is not None]
+    return {
+        "episodes": len(episodes),
+        "success_rate": float(np.mean([e["success"] for e in episodes])),
+        "position_error_median": float(np.median(pe)), "position_error_p90": float(np.percentile(pe, 90)),
+        "attitude_error_median": float(np.median(ae)), "attitude_error_p90": float(np.percentile(ae, 90)),
+        "reached_fraction": len(reach) / len(episodes),
+        "steps_to_reach_median": float(np.median(reach)) if reach else None,
+        "position_tolerance_m": probes.POSITION_TOLERANCE, "attitude_tolerance_deg": probes.ATTITUDE_TOLERANCE,
+    }
+
+
+def heldout_targets(domain: str, num_targets: Optional[int] = None):
+    """robostrich_suite.targets.heldout_targets() for the arm; None (seeded episodes) elsewhere."""
+    if domain not in ROBOSTRICH_DOMAINS:
+        return None
+    from robostrich_suite import targets
+    pool = np.asarray(targets.heldout_targets(), np.float64)
+    return pool if num_targets is None else pool[:num_targets]
+
+
+def evaluate_heldout(actor, flattener, domain: str, task: str, num_targets: Optional[int] = None,
+                     seed: int = 10_000) -> dict:
+    """Deterministic policy, one episode per held-out target (pool of that single target)."""
+    targets = heldout_targets(domain, num_targets)
+    episodes = []
+    count = len(targets) if targets is not None else (num_targets or 10)
+    for i in range(count):
+        kwargs = {"target_pool": targets[i:i + 1]} if targets is not None else {}
+        env = make_environment(domain, task, seed + i, **kwargs)
+        row = _episode_summary(rollout(env, actor, flattener))
+        if targets is not None:
+            row["target"] = targets[i].tolist()
+        episodes.append(row)
+    return {"kind": "heldout", "domain": domain, "task": task, "summary": summarize(episodes), "episodes": episodes}
+
+
+def evaluate_track(actor, flattener, domain: str = "robostrich", task: str = "track", seed: int = 20_000,
+                   recorder=None) -> dict:
+    """The `track` task: targets in order (Fig. 7); one summary per target segment plus the series."""
+    env = make_environment(domain, task, seed)
+    series = rollout(env, actor, flattener, recorder=recorder)
+    segments = []
+    targets = series["target"]
+    bounds = [0] + [i for i in range(1, len(targets)) if targets[i] != targets[i - 1]] + [len(series["time"])]
+    for start, end in zip(bounds[:-1], bounds[1:]):
+        row = _episode_summary(series, start, end)
+        row.update(start_step=start, target=targets[start] if targets else None)
+        segments.append(row)
+    return {"kind": "track", "domain": domain, "task": task, "segments": segments,
+            "summary": summarize(segments), "series": series}
+
+
+def evaluate_agent(actor, flattener, out_dir: str, label: str, domain: str, heldout_task: str,
+                   track_task: Optional[str], num_targets: Optional[int] = None, env_steps: int = None,
+                   record: bool = True) -> dict:
+    """Held-out + track evaluation, JSON reports and (optionally) a Rerun recording of the track rollout."""
+    os.makedirs(out_dir, exist_ok=True)
+    reports = {"heldout": evaluate_heldout(actor, flattener, domain, heldout_task, num_targets)}
+    if track_task:
+        recorder = None
+        if record:
+            from agents.recording import RolloutRecorder
+            recorder = RolloutRecorder(os.path.join(out_dir, f"{label}_track.rrd"), name=f"{label} track")
+        try:
+            reports["track"] = evaluate_track(actor, flattener, domain, track_task, recorder=recorder)
+        finally:
+            if recorder is not None:
+                recorder.close()
+    for kind, report in reports.items():
+        report.update(label=label, env_steps=env_steps)
+        write_json(os.path.join(out_dir, f"{label}_{kind}.json"), report)
+    return reports
+
+
+def write_json(path: str, obj) -> None:
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(obj, f, indent=1, default=_json_default)
+    os.replace(tmp, path)
+
+
+def _json_default(o):
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    raise TypeError(f"not JSON serialisable: {type(o)}")
+
+
+def load_run_from_checkpoint(path: str):
+    """Rebuild the CurriculumRun that wrote `path` (its fingerprint holds config, plan and seed)."""
+    from agents import checkpoint
+    from agents.curriculum import CurriculumRun, parse_plan
+    from agents.sac.config import SACConfig
+    fp = checkpoint.read_fingerprint(path)
+    run = CurriculumRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"],
+                        os.path.join(os.path.dirname(os.path.abspath(path)), ".evaluate"))
+    run.restore(path)
+    return run
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description="Evaluate a checkpoint: held-out targets and the track task.")
+    parser.add_argument("checkpoint", help="checkpoint.pkl written by robostrich-train")
+    parser.add_argument("--out", default=None, help="report directory (default: next to the checkpoint)")
+    parser.add_argument("--label", default="eval")
+    parser.add_argument("--heldout-task", default=None, help="task for held-out targets (default: last lesson's)")
+    parser.add_argument("--track-task", default="track", help="'' to skip")
+    parser.add_argument("--num-targets", type=int, default=None)
+    parser.add_argument("--no-rerun", action="store_true")
+    parser.add_argument("--no-figures", action="store_true")
+    args = parser.parse_args(argv)
+    run = load_run_from_checkpoint(args.checkpoint)
+    domain = run.plan[-1].domain
+    out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.checkpoint)), "evaluation")
+    from agents.sac.builder import SACBuilder
+    actor = SACBuilder.make_eval_actor(run.loop)
+    track_task = args.track_task if domain in ROBOSTRICH_DOMAINS else None
+    reports = evaluate_agent(actor, run.loop.flattener, out, args.label, domain,
+                             args.heldout_task or run.plan[-1].task, track_task or None, args.num_targets,
+                             env_steps=run.loop.env_steps, record=not args.no_rerun)
+    if not args.no_figures and "track" in reports:
+        from agents import figures
+        figures.plot_track({args.label: reports["track"]}, os.path.join(out, f"{args.label}_track.png"))
+    print(json.dumps({k: r["summary"] for k, r in reports.items()}, indent=1))
+    return reports
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,124 @@
+"""Rerun recordings: evaluation rollouts (arm, head path, targets, tendon inputs, errors) and training curves.
+
+The arm itself is drawn by `robostrich_suite.rerun_log` when the simulation
+package provides it; other dm_control domains fall back to their body
+positions as a line strip (development only).
+"""
+from typing import Dict, List
+
+import numpy as np
+import rerun as rr
+
+
+def _to_3d(xz):
+    """The arm is planar in the sagittal x-z plane; Rerun wants 3D points (y = 0)."""
+    xz = np.asarray(xz, np.float64).reshape(-1)
+    return [float(xz[0]), 0.0, float(xz[1])] if xz.size == 2 else [float(v) for v in xz[:3]]
+
+
+class RolloutRecorder:
+    """Streams one rollout to an .rrd file on a `sim_time` timeline."""
+
+    def __init__(self, path: str, name: str = "rollout", application_id: str = "robostrich"):
+        self.path = path
+        self.rec = rr.RecordingStream(application_id, recording_id=name)
+        self.rec.save(path)
+        self.head_path: List[list] = []
+        self.targets: List[list] = []
+        self.step = 0
+        self._arm_logger = None
+        self._arm_logger_checked = False
+
+    def _log_arm(self, env):
+        if not self._arm_logger_checked:
+            self._arm_logger_checked = True
+            try:
+                from robostrich_suite import rerun_log
+                self._arm_logger = rerun_log
+            except ImportError:
+                self._arm_logger = None
+        physics = env.physics
+        if self._arm_logger is not None and hasattr(physics, "head_position"):
+            log_physics(self._arm_logger, self.rec, physics)
+        else:
+            xpos = np.asarray(physics.data.xpos[1:], np.float64)
+            self.rec.log("world/arm", rr.LineStrips3D([xpos], radii=0.005))
+
+    def log_step(self, env, action, timestep, position_error=None, attitude_error=None):
+        physics, rec = env.physics, self.rec
+        rec.set_time("sim_time", duration=float(physics.data.time))
+        rec.set_time("step", sequence=self.step)
+        self.step += 1
+        self._log_arm(env)
+        if hasattr(physics, "head_position"):
+            head = _to_3d(physics.head_position())
+            self.head_path.append(head)
+            rec.log("world/head", rr.Points3D([head], radii=0.008, colors=[[255, 200, 0]]))
+            rec.log("plots/head_attitude_deg", rr.Scalars(float(physics.head_attitude())))
+        if hasattr(env.task, "target_position"):
+            target = _to_3d(env.task.target_position)
+            if not self.targets or self.targets[-1] != target:
+                self.targets.append(target)
+            rec.log("world/target", rr.Points3D([target], radii=0.012, colors=[[230, 40, 40]]))
+        if action is not None:
+            rec.log("plots/tendon_input", rr.Scalars(np.asarray(action, np.float64)))
+        if position_error is not None and np.isfinite(position_error):
+            rec.log("plots/position_error_m", rr.Scalars(float(position_error)))
+        if attitude_error is not None and np.isfinite(attitude_error):
+            rec.log("plots/attitude_error_deg", rr.Scalars(float(attitude_error)))
+        if timestep.reward is not None:
+            rec.log("plots/reward", rr.Scalars(float(timestep.reward)))
+
+    def close(self):
+        if len(self.head_path) > 1:
+            self.rec.log("world/head_path", rr.LineStrips3D([self.head_path], radii=0.002,
+                                                          colors=[[255, 200, 0]]), static=True)
+        if self.targets:
+            self.rec.log("world/all_targets", rr.Points3D(self.targets, radii=0.01, colors=[[230, 40, 40]],
+                                                          labels=[f"target {i + 1}" for i in range(len(self.targets))]),
+                         static=True)
+        self.rec.flush()
+        self.rec.disconnect()
+
+
+def log_physics(rerun_log_module, rec, physics):
+    """Adapter around robostrich_suite.rerun_log (its API is looked up, not assumed)."""
+    for name in ("log_arm", "log_physics", "log_state"):
+        fn = getattr(rerun_log_module, name, None)
+        if fn is not None:
+            try:
+                fn(physics, recording=rec)
+            except TypeError:
+                fn(rec, physics)
+            return
+    raise AttributeError(f"robostrich_suite.rerun_log has none of log_arm/log_physics/log_state")
+
+
+CURVE_FIELDS = ("return", "success", "position_error", "attitude_error", "critic_loss", "actor_loss",
+                "alpha_loss", "temperature", "entropy")
+
+
+def log_training_curves(path: str, runs: Dict[str, List[dict]], evals: Dict[str, List[dict]] = None):
+    """Training curves of each run on an `env_steps` timeline (one .rrd, one entity per run and field)."""
+    rec = rr.RecordingStream("robostrich", recording_id="training")
+    rec.save(path)
+    for label, records in runs.items():
+        if not records:
+            continue
+        steps = np.array([r["env_steps"] for r in records], np.int64)
+        for field in CURVE_FIELDS:
+            values = np.array([float(r.get(field, np.nan)) for r in records], np.float64)
+            keep = np.isfinite(values)
+            if keep.any():
+                rec.send_columns(f"training/{field}/{label}", indexes=[rr.TimeColumn("env_steps", sequence=steps[keep])],
+                                 columns=rr.Scalars.columns(scalars=values[keep]))
+    for label, records in (evals or {}).items():
+        if not records:
+            continue
+        steps = np.array([r["env_steps"] for r in records], np.int64)
+        for field in ("success_rate", "position_error_median", "attitude_error_median"):
+            values = np.array([r["summary"][field] for r in records], np.float64)
+            rec.send_columns(f"heldout/{field}/{label}", indexes=[rr.TimeColumn("env_steps", sequence=steps)],
+                             columns=rr.Scalars.columns(scalars=values))
+    rec.flush()
+    rec.disconnect()

@@ -1,0 +1,10 @@
+"""Thin shim: `python tools/evaluate.py CHECKPOINT ...` == `robostrich-evaluate ...` (see agents/evaluation.py)."""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+from agents.evaluation import main  # noqa: E402
+
+if __name__ == "__main__":
+    main()
