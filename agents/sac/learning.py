@@ -3,6 +3,7 @@
 `SACLearner.step(batches)` runs `batches.reward.shape[0]` updates inside a
 single `lax.scan`, so Python is entered once per call, not once per update.
 """
+import functools
 from typing import NamedTuple
 
 import jax
@@ -113,19 +114,25 @@ def make_update_fn(networks: SACNetworks, config: SACConfig):
     return update
 
 
+@functools.lru_cache(maxsize=None)
+def _jitted_update_many(networks: SACNetworks, config: SACConfig):
+    """One compiled function per (networks, config), shared by all learners that match."""
+    update = make_update_fn(networks, config)
+
+    def update_many(state, batches):
+        state, metrics = jax.lax.scan(update, state, batches)
+        return state, jax.tree_util.tree_map(jnp.mean, metrics)
+
+    return jax.jit(update_many)
+
+
 class SACLearner:
     """Holds the training state; `step` runs a stack of updates in one jitted call."""
 
     def __init__(self, networks: SACNetworks, config: SACConfig, key):
         self.networks = networks
         self.config = config
-        update = make_update_fn(networks, config)
-
-        def update_many(state, batches):
-            state, metrics = jax.lax.scan(update, state, batches)
-            return state, jax.tree_util.tree_map(jnp.mean, metrics)
-
-        self._update_many = jax.jit(update_many)
+        self._update_many = _jitted_update_many(networks, config)
         self.state = init_state(networks, config, key)
 
     def step(self, batches: Transitions) -> dict:

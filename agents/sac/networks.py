@@ -4,6 +4,7 @@ The policy acts in [-1, 1]^|A|; mapping to the environment's bounds is the
 actor's job (agents/actors.py), so the networks never see physical units.
 """
 import dataclasses
+import functools
 from typing import Callable, Sequence
 
 import haiku as hk
@@ -47,7 +48,13 @@ def tanh_gaussian_log_prob(u, mean, log_std):
 
 def make_networks(obs_size: int, action_size: int, hidden_sizes: Sequence[int] = (256, 256),
                   log_std_min: float = -5.0, log_std_max: float = 2.0) -> SACNetworks:
-    hidden_sizes = tuple(hidden_sizes)
+    """Cached: equal arguments give the same object, so learners and actors share compiled functions."""
+    return _make_networks(int(obs_size), int(action_size), tuple(int(h) for h in hidden_sizes),
+                          float(log_std_min), float(log_std_max))
+
+
+@functools.lru_cache(maxsize=None)
+def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max) -> SACNetworks:
 
     def policy_fn(obs):
         h = hk.nets.MLP(hidden_sizes, activation=jax.nn.relu, activate_final=True, name="policy_torso")(obs)

@@ -1,0 +1,119 @@
+"""Unit tests of the SAC pieces: real JAX, tiny networks."""
+import jax
+import numpy as np
+import pytest
+from dm_env import specs
+
+from agents.actors import ActionAdapter, Actor
+from agents.replay import ObservationFlattener, ReplayBuffer
+from agents.sac.config import SACConfig
+from agents.sac.learning import SACLearner, Transitions
+from agents.sac.networks import make_networks, tanh_gaussian_log_prob
+
+OBS, ACT = 6, 3
+TINY = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=1, max_replay_size=1000,
+                 updates_per_call=4, env_steps_per_call=4)
+
+
+def random_batch(num_updates, batch, seed=0):
+    rng = np.random.default_rng(seed)
+    return Transitions(rng.normal(size=(num_updates, batch, OBS)).astype(np.float32),
+                       rng.uniform(-1, 1, size=(num_updates, batch, ACT)).astype(np.float32),
+                       rng.normal(size=(num_updates, batch)).astype(np.float32),
+                       np.ones((num_updates, batch), np.float32),
+                       rng.normal(size=(num_updates, batch, OBS)).astype(np.float32))
+
+
+def make_learner(seed=0, config=TINY):
+    return SACLearner(make_networks(OBS, ACT, config.hidden_sizes), config, jax.random.PRNGKey(seed))
+
+
+def leaves(tree):
+    return [np.asarray(x) for x in jax.tree_util.tree_leaves(tree)]
+
+
+def test_critic_loss_falls_on_a_fixed_batch():
+    learner = make_learner()
+    # discount 0: the Bellman target is the reward itself, so the critics face a fixed regression.
+    fixed = random_batch(1, 32)._replace(discount=np.zeros((1, 32), np.float32))
+    stack = Transitions(*(np.repeat(x, 25, axis=0) for x in fixed))
+    losses = [float(learner.step(stack)["critic_loss"]) for _ in range(8)]
+    assert all(np.isfinite(losses)) and losses[-1] < 0.4 * losses[0], losses
+
+
+def test_update_is_deterministic_for_a_seed_and_differs_across_seeds():
+    batches = random_batch(3, 32, seed=1)
+    a, b, c = make_learner(seed=3), make_learner(seed=3), make_learner(seed=4)
+    ma, mb = a.step(batches), b.step(batches)
+    c.step(batches)
+    for x, y in zip(leaves(a.state), leaves(b.state)):
+        np.testing.assert_array_equal(x, y)
+    assert float(ma["critic_loss"]) == float(mb["critic_loss"])
+    assert any(not np.array_equal(x, y) for x, y in zip(leaves(a.state.policy_params), leaves(c.state.policy_params)))
+    assert a.num_updates == 3
+
+
+def test_scan_of_k_updates_equals_k_single_updates():
+    batches = random_batch(4, 32, seed=2)
+    a, b = make_learner(seed=5), make_learner(seed=5)
+    a.step(batches)
+    for i in range(4):
+        b.step(Transitions(*(x[i:i + 1] for x in batches)))
+    for x, y in zip(leaves(a.state), leaves(b.state)):
+        np.testing.assert_allclose(x, y, rtol=1e-5, atol=1e-6)
+
+
+def test_temperature_rises_when_entropy_is_below_target():
+    config = SACConfig(**{**TINY.to_dict(), "target_entropy": 100.0, "hidden_sizes": (32, 32)})
+    learner = make_learner(config=config)
+    before = float(np.exp(learner.state.log_alpha))
+    learner.step(random_batch(20, 32))
+    assert float(np.exp(learner.state.log_alpha)) > before
+
+
+def test_tanh_gaussian_log_prob_matches_change_of_variables():
+    u = np.array([[-3.0, 0.1, 8.0]], np.float32)
+    mean, log_std = np.zeros_like(u), np.full_like(u, -0.5)
+    sigma = np.exp(-0.5)
+    gauss = -0.5 * (u / sigma) ** 2 - np.log(sigma) - 0.5 * np.log(2 * np.pi)
+    expected = np.sum(gauss - np.log(1 - np.tanh(u.astype(np.float64)) ** 2 + 1e-30), axis=-1)
+    np.testing.assert_allclose(np.asarray(tanh_gaussian_log_prob(u, mean, log_std)), expected, rtol=1e-4)
+
+
+def test_action_adapter_maps_policy_box_onto_asymmetric_bounds():
+    spec = specs.BoundedArray((3,), np.float64, minimum=[-0.1, -0.02, 0.0], maximum=[0.08, 0.05, 0.3])
+    adapter = ActionAdapter(spec)
+    np.testing.assert_allclose(adapter.to_env([-1, -1, -1]), spec.minimum)
+    np.testing.assert_allclose(adapter.to_env([1, 1, 1]), spec.maximum)
+    x = np.array([0.3, -0.7, 0.9])
+    np.testing.assert_allclose(adapter.to_policy(adapter.to_env(x)), x, atol=1e-6)
+    with pytest.raises(ValueError, match="BoundedArray"):
+        ActionAdapter(specs.Array((3,), np.float64))
+
+
+def test_actor_stays_in_bounds_and_rejects_nan():
+    spec = specs.BoundedArray((ACT,), np.float64, minimum=-0.1, maximum=0.08)
+    learner = make_learner()
+    actor = Actor(learner.networks, ActionAdapter(spec), learner.policy_params, key=jax.random.PRNGKey(1))
+    acts = np.array([actor.select_action(np.random.default_rng(i).normal(size=OBS).astype(np.float32) * 10)
+                     for i in range(50)])
+    assert acts.min() >= -0.1 and acts.max() <= 0.08 and acts.std() > 0
+    det = Actor(learner.networks, ActionAdapter(spec), learner.policy_params, deterministic=True)
+    obs = np.ones(OBS, np.float32)
+    np.testing.assert_array_equal(det.select_action(obs), det.select_action(obs))
+    with pytest.raises(ValueError, match="non-finite"):
+        actor.select_action(np.full(OBS, np.nan, np.float32))
+
+
+def test_replay_flattens_dict_observations_and_wraps():
+    obs_spec = {"b": specs.Array((2,), np.float64), "a": specs.Array((), np.float64)}
+    flatten = ObservationFlattener(obs_spec)
+    np.testing.assert_array_equal(flatten({"a": 3.0, "b": np.array([1.0, 2.0])}), [1, 2, 3])  # spec order
+    replay = ReplayBuffer(3, 1, capacity=4, seed=0)
+    for i in range(6):
+        replay.add(np.full(3, i), [0.5], float(i), 1.0, np.full(3, i + 1))
+    assert len(replay) == 4 and replay.insert_index == 2
+    assert sorted(replay.reward.tolist()) == [2, 3, 4, 5]
+    batch = replay.sample_stack(2, 5)
+    assert batch.obs.shape == (2, 5, 3) and set(batch.reward.ravel()) <= {2, 3, 4, 5}
+    np.testing.assert_array_equal(batch.next_obs[..., 0], batch.obs[..., 0] + 1)
