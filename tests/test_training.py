@@ -1,0 +1,120 @@
+"""Checkpoints, resumption and the curriculum, on dm_control's point_mass (real MuJoCo, tiny networks)."""
+import json
+import os
+
+import jax
+import numpy as np
+import pytest
+
+from agents import checkpoint, training
+from agents.curriculum import CurriculumRun, TrainingInterrupted, parse_plan
+from agents.sac.config import SACConfig
+
+TINY = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=200, max_replay_size=5000,
+                 updates_per_call=4, env_steps_per_call=8)
+TINY_ARGS = ["--domain", "point_mass", "--hidden", "32,32", "--batch-size", "32", "--min-replay", "200",
+             "--replay-size", "5000", "--updates-per-call", "4", "--env-steps-per-call", "8",
+             "--num-eval-targets", "1", "--no-figures", "--no-rerun", "--quiet", "--no-baseline"]
+
+
+def leaves(tree):
+    return [np.asarray(x) for x in jax.tree_util.tree_leaves(tree)]
+
+
+def assert_same_run(a: CurriculumRun, b: CurriculumRun):
+    for x, y in zip(leaves(a.loop.learner.state), leaves(b.loop.learner.state)):
+        np.testing.assert_array_equal(x, y)
+    np.testing.assert_array_equal(np.asarray(a.loop.actor.key), np.asarray(b.loop.actor.key))
+    assert a.loop.env_steps == b.loop.env_steps and a.loop.episodes == b.loop.episodes
+    assert (a.lesson_index, a.lesson_steps) == (b.lesson_index, b.lesson_steps)
+    assert len(a.loop.replay) == len(b.loop.replay)
+    n = len(a.loop.replay)
+    np.testing.assert_array_equal(a.loop.replay.obs[:n], b.loop.replay.obs[:n])
+    np.testing.assert_array_equal(a.loop.env.physics.get_state(), b.loop.env.physics.get_state())
+
+
+def test_checkpoint_round_trips_bit_exactly_and_continues_identically(tmp_path):
+    plan = parse_plan("point_mass/easy:700")
+    a = CurriculumRun(plan, TINY, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
+    with pytest.raises(TrainingInterrupted):
+        a.run(stop_at_step=450)  # mid-episode, after learning started
+    assert a.loop.learner.num_updates > 0
+    path = str(tmp_path / "ckpt.pkl")
+    a.save_checkpoint(path)
+    b = CurriculumRun(plan, TINY, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
+    b.restore(path)
+    assert_same_run(a, b)
+    a.run()
+    b.run()
+    assert_same_run(a, b)
+
+
+def test_killed_and_resumed_run_matches_an_uninterrupted_one(tmp_path):
+    args = TINY_ARGS + ["--plan", "point_mass/easy:600,point_mass/hard:600", "--checkpoint-every", "400",
+                        "--seed", "3"]
+    whole, killed = str(tmp_path / "whole"), str(tmp_path / "killed")
+    training.main(args + ["--out", whole])
+    with pytest.raises(TrainingInterrupted):
+        training.main(args + ["--out", killed, "--stop-at-step", "1000"])  # last checkpoint at 800
+    with pytest.raises(ValueError, match="--resume"):
+        training.main(args + ["--out", killed])  # never silently restarts over a checkpoint
+    training.main(args + ["--out", killed, "--resume"])
+    fp = checkpoint.read_fingerprint(os.path.join(whole, "curriculum", "checkpoint.pkl"))
+    a, b = (checkpoint.load(os.path.join(d, "curriculum", "checkpoint.pkl"), fp) for d in (whole, killed))
+    assert a["loop"]["env_steps"] == b["loop"]["env_steps"] == 1200
+    assert (a["lesson_index"], a["lesson_steps"]) == (b["lesson_index"], b["lesson_steps"]) == (2, 0)
+    assert int(a["learner"].steps) == int(b["learner"].steps) > 0
+    for x, y in zip(leaves(a["learner"]), leaves(b["learner"])):
+        np.testing.assert_array_equal(x, y)
+    for name in ("metrics.jsonl", "evals.jsonl"):  # no duplicated records after the resume
+        ra, rb = (open(os.path.join(d, "curriculum", name)).read().splitlines() for d in (whole, killed))
+        assert [json.loads(l)["env_steps"] for l in ra] == [json.loads(l)["env_steps"] for l in rb]
+
+
+def test_mismatched_or_damaged_checkpoint_raises(tmp_path):
+    plan = parse_plan("point_mass/easy:300")
+    a = CurriculumRun(plan, TINY, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300)
+    a.run()
+    other = SACConfig(**{**TINY.to_dict(), "batch_size": 64, "hidden_sizes": (32, 32)})
+    b = CurriculumRun(plan, other, seed=0, run_dir=str(tmp_path / "b"))
+    with pytest.raises(ValueError, match="batch_size: checkpoint has 32, this run has 64"):
+        b.restore(a.checkpoint_path)
+    c = CurriculumRun(plan, TINY, seed=5, run_dir=str(tmp_path / "c"))
+    with pytest.raises(ValueError, match="seed"):
+        c.restore(a.checkpoint_path)
+    data = bytearray(open(a.checkpoint_path, "rb").read())
+    data[len(data) // 2] ^= 0xFF
+    damaged = str(tmp_path / "damaged.pkl")
+    open(damaged, "wb").write(bytes(data))
+    d = CurriculumRun(plan, TINY, seed=0, run_dir=str(tmp_path / "d"))
+    with pytest.raises(ValueError, match="damaged"):
+        d.restore(damaged)
+    open(damaged, "wb").write(bytes(data[:20]))
+    with pytest.raises(ValueError, match="truncated"):
+        d.restore(damaged)
+
+
+def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
+    plan = parse_plan("point_mass/easy:500,point_mass/hard:500")
+    run = CurriculumRun(plan, TINY, seed=2, run_dir=str(tmp_path), checkpoint_every=10_000)
+    seen = {}
+
+    def on_eval(r):  # called right after the switch to lesson 2
+        seen["policy"] = leaves(r.loop.learner.state.policy_params)
+        seen["updates"] = r.loop.learner.num_updates
+        seen["replay"] = len(r.loop.replay)
+        seen["env"] = r.loop.env
+        seen["learner"] = r.loop.learner
+
+    initial = leaves(run.loop.learner.state.policy_params)
+    first_env = run.loop.env
+    run.run(on_eval=on_eval, eval_at=[500])
+    assert seen["env"] is not first_env and run.lesson_index == 2
+    assert seen["replay"] == 500 and len(run.loop.replay) == 1000  # lesson-1 data stays in the replay
+    assert seen["updates"] == 38 * 4  # calls at steps 200, 208, ..., 496
+    assert run.loop.learner is seen["learner"] and run.loop.learner.num_updates > seen["updates"]
+    # lesson 2 starts from lesson 1's trained parameters, not a fresh initialisation
+    assert any(not np.array_equal(x, y) for x, y in zip(seen["policy"], initial))
+    fresh = CurriculumRun(plan[1:], TINY, seed=2, run_dir=str(tmp_path / "fresh"))
+    assert any(not np.array_equal(x, y) for x, y in zip(seen["policy"], leaves(fresh.loop.learner.policy_params)))
+    assert float(np.exp(run.loop.learner.state.log_alpha)) != TINY.init_temperature
