@@ -1,0 +1,65 @@
+"""robostrich_suite: dm_control domains for the tendon-driven Robostrich arm.
+
+    import robostrich_suite
+    env = robostrich_suite.load("robostrich", "lesson2")
+
+``load`` mirrors ``dm_control.suite.load`` for this package's domains (which
+dm_control's own registry does not know about).
+"""
+from __future__ import annotations
+
+import collections
+import inspect
+
+from robostrich_suite import robostrich
+
+_DOMAINS = collections.OrderedDict(
+    (name, module) for name, module in [("robostrich", robostrich)])
+
+
+def _register_optional_domains():
+    """Domains that live in modules of their own register here when importable."""
+    try:
+        from robostrich_suite import robostrich_a1
+    except ImportError:
+        return
+    _DOMAINS["robostrich_a1"] = robostrich_a1
+
+
+_register_optional_domains()
+
+ALL_TASKS = tuple((domain, task) for domain, module in _DOMAINS.items()
+                  for task in module.SUITE)
+TASKS_BY_DOMAIN = collections.OrderedDict(
+    (domain, tuple(module.SUITE)) for domain, module in _DOMAINS.items())
+CURRICULUM_TASKS = tuple((domain, task) for domain, module in _DOMAINS.items()
+                         for task in module.SUITE.tagged("curriculum"))
+
+
+def load(domain_name, task_name, task_kwargs=None, environment_kwargs=None, visualize_reward=False):
+    """Returns an environment from a domain name, task name and optional settings.
+
+    Args:
+      domain_name: e.g. ``"robostrich"``; see ``TASKS_BY_DOMAIN``.
+      task_name: e.g. ``"lesson2"``.
+      task_kwargs: keyword arguments of the task factory (``random`` seeds it).
+      environment_kwargs: keyword arguments of ``dm_control.rl.control.Environment``.
+      visualize_reward: accepted for ``dm_control.suite.load`` compatibility; unused.
+    """
+    del visualize_reward
+    if domain_name not in _DOMAINS:
+        raise ValueError(f"unknown domain {domain_name!r}; domains are {list(_DOMAINS)}")
+    domain = _DOMAINS[domain_name]
+    if task_name not in domain.SUITE:
+        raise ValueError(f"domain {domain_name!r} has no task {task_name!r}; "
+                         f"tasks are {list(domain.SUITE)}")
+    task_kwargs = dict(task_kwargs or {})
+    if environment_kwargs is not None:
+        task_kwargs["environment_kwargs"] = environment_kwargs
+    factory = domain.SUITE[task_name]
+    accepted = inspect.signature(factory).parameters
+    if not any(p.kind == p.VAR_KEYWORD for p in accepted.values()):
+        unknown = set(task_kwargs) - set(accepted)
+        if unknown:
+            raise ValueError(f"{domain_name}/{task_name} does not take {sorted(unknown)}")
+    return factory(**task_kwargs)

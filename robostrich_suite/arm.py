@@ -1,0 +1,411 @@
+"""MJCF generator for tendon-driven planar necks such as the Robostrich arm.
+
+The arm is a chain of passive hinge joints in the sagittal (x-z) plane.  Every
+link has two run-through holes (sites), one on its dorsal and one on its ventral
+side; each tendon is a spatial tendon from an anchor on the base, through the
+holes of the links it is listed with, to its insertion link.  One ``general``
+actuator per tendon servos the tendon's *contraction* and can only pull.
+
+Conventions (used by every other module):
+
+* The chain leaves the base along the base body's +z axis, caudal (C18) first,
+  cranial (atlas/head) last.  Joints turn about +y.
+* A positive joint angle is **ventral** flexion: it turns the cranial part of
+  the neck towards +x, the ventral (throat) side.  Joint ranges are therefore
+  ``[-dorsal_limit, +ventral_limit]``.  Ventral holes sit at +x, dorsal at -x.
+* On the immobile frame the neck stands up (+z) and the animal faces +x, so
+  ventral flexion brings the head forward and down.  The head attitude is the
+  angle of the head's axis from the vertical: 0 deg pointing up, 90 deg level
+  (the paper's Fig. 2B), 180 deg pointing down.
+* Actuator control = tendon contraction in metres (target length = rest length
+  minus control).  Negative control lets the tendon pay out (go slack).
+
+Everything the generator needs comes from an :class:`ArmSpec` (by default
+:func:`ArmSpec.from_table1`) and a :class:`TendonLayout` (by default
+:func:`TendonLayout.robostrich`).  Bad specs and layouts raise ``ValueError``
+naming the offending item.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Sequence
+
+import numpy as np
+from dm_control import mjcf
+
+from robostrich_suite import table1
+
+SIDES = ("dorsal", "ventral")
+ARM_MODEL_NAME = "arm"
+HEAD_SITE = "head"
+HEAD_VELOCITY_SENSOR = "head_velocity"
+COLLISION_TYPE = 2  # contype of arm geoms; obstacles the arm may touch set this bit in conaffinity.
+
+
+@dataclasses.dataclass(frozen=True)
+class ArmSpec:
+    """Geometry, inertia and passive/actuator parameters of a planar tendon neck.
+
+    Sequences run cranial (head) to caudal (base), one entry per joint.  The
+    first joint's body is the head; ``link_lengths`` has one entry fewer than
+    ``joint_names`` (the head's length is ``head_length``).
+    """
+    joint_names: tuple[str, ...]
+    dorsal_limits_deg: tuple[float, ...]
+    ventral_limits_deg: tuple[float, ...]
+    link_lengths: tuple[float, ...]  # metres, for joint_names[1:]
+    masses: tuple[float, ...]  # kilograms, head first
+    head_length: float = 0.06  # m, skull + beak along the head axis
+    head_site_fraction: float = 0.5  # where along the head its "position" is measured
+    link_radius: float = 0.008  # m, capsule radius of each vertebra
+    hole_offset: float = 0.015  # m, distance of the run-through holes from the joint axis line
+    hole_fraction: float = 0.5  # where along a link its holes are (0 caudal joint, 1 cranial joint)
+    anchor_depth: float = 0.03  # m, tendon anchors sit this far below the first joint on the base
+    # Passive intervertebral joint: a plausible neck neither collapses under its own
+    # weight nor rings for seconds.  Stiffness is per joint, towards the straight pose.
+    joint_stiffness: float = 1.0  # N m / rad
+    joint_damping: float = 0.1  # N m s / rad
+    joint_armature: float = 2e-4  # kg m^2; keeps the 5 g links stable at 2 ms steps
+    # Joint limits are soft constraints; on links this light a default limit lets a
+    # 100 N tendon push a joint 10-20 deg past Table 1.  These keep it within ~0.5 deg
+    # without chattering at the 2 ms physics step (measured over random tendon inputs).
+    limit_solref: tuple[float, float] = (0.008, 1.0)
+    limit_solimp: tuple[float, float, float] = (0.95, 0.99, 0.001)
+    # Tendon servo: force = -kp (length - (rest - contraction)) - kv d(length)/dt, pull only.
+    tendon_kp: float = 4000.0  # N / m
+    tendon_kv: float = 40.0  # N s / m
+    tendon_max_force: float = 150.0  # N, upper bound of the pull
+
+    @classmethod
+    def from_table1(cls, **overrides) -> "ArmSpec":
+        """The Robostrich arm of the paper's Table 1 (SI units)."""
+        spec = cls(
+            joint_names=table1.JOINT_NAMES,
+            dorsal_limits_deg=tuple(float(x) for x in table1.DORSAL_LIMIT_DEG),
+            ventral_limits_deg=tuple(float(x) for x in table1.VENTRAL_LIMIT_DEG),
+            link_lengths=tuple(x / 1000.0 for x in table1.LENGTH_MM[1:]),
+            masses=tuple(x / 1000.0 for x in table1.MASS_G),
+        )
+        return dataclasses.replace(spec, **overrides)
+
+    @property
+    def head_name(self) -> str:
+        return self.joint_names[0]
+
+    @property
+    def base_link(self) -> str:
+        return self.joint_names[-1]
+
+    @property
+    def num_joints(self) -> int:
+        return len(self.joint_names)
+
+    def joint_range_rad(self) -> np.ndarray:
+        """(num_joints, 2) array of [min, max] angles in radians (dorsal negative)."""
+        return np.stack([-np.radians(self.dorsal_limits_deg),
+                         np.radians(self.ventral_limits_deg)], axis=1)
+
+    def validate(self) -> None:
+        """Raise ``ValueError`` naming the first inconsistent entry."""
+        n = len(self.joint_names)
+        if n < 2:
+            raise ValueError(f"an arm needs at least 2 joints, got {n}")
+        if len(set(self.joint_names)) != n:
+            dup = sorted({x for x in self.joint_names if self.joint_names.count(x) > 1})
+            raise ValueError(f"duplicate joint/link names: {dup}")
+        for field, expected in (("dorsal_limits_deg", n), ("ventral_limits_deg", n),
+                                ("masses", n), ("link_lengths", n - 1)):
+            got = len(getattr(self, field))
+            if got != expected:
+                raise ValueError(f"{field} has {got} entries, expected {expected} "
+                                 f"(one per joint{'' if expected == n else ' except the head'})")
+        for name, dorsal, ventral in zip(self.joint_names, self.dorsal_limits_deg,
+                                         self.ventral_limits_deg):
+            if not (0 <= dorsal < 180):
+                raise ValueError(f"joint {name!r}: dorsal limit {dorsal} deg must be in [0, 180)"
+                                 " (a positive magnitude; the sign convention is applied for you)")
+            if not (0 <= ventral < 180):
+                raise ValueError(f"joint {name!r}: ventral limit {ventral} deg must be in [0, 180)"
+                                 " (a positive magnitude; the sign convention is applied for you)")
+        for name, mass in zip(self.joint_names, self.masses):
+            if not mass > 0:
+                raise ValueError(f"link {name!r}: mass {mass} kg must be positive")
+        for name, length in zip(self.joint_names[1:], self.link_lengths):
+            if not length > 0:
+                raise ValueError(f"link {name!r}: length {length} m must be positive")
+        for field in ("head_length", "link_radius", "hole_offset", "tendon_kp",
+                      "tendon_max_force", "joint_armature"):
+            if not getattr(self, field) > 0:
+                raise ValueError(f"{field} must be positive, got {getattr(self, field)}")
+        for field in ("joint_stiffness", "joint_damping", "tendon_kv", "anchor_depth"):
+            if getattr(self, field) < 0:
+                raise ValueError(f"{field} must be non-negative, got {getattr(self, field)}")
+        for field in ("hole_fraction", "head_site_fraction"):
+            if not 0 <= getattr(self, field) <= 1:
+                raise ValueError(f"{field} must be in [0, 1], got {getattr(self, field)}")
+
+
+@dataclasses.dataclass(frozen=True)
+class TendonSpec:
+    """One tendon: anchored on the base, through ``links`` (caudal to cranial).
+
+    The last link in ``links`` is the insertion.  Each link contributes its
+    hole on ``side``; the anchor on the base counts as the first point, so a
+    tendon needs at least two holes to act on a joint beyond the first.
+    """
+    name: str
+    side: str
+    links: tuple[str, ...]
+
+    @property
+    def insertion(self) -> str:
+        return self.links[-1]
+
+    @classmethod
+    def spanning(cls, name: str, side: str, insertion: str, spec: ArmSpec,
+                 origin: str | None = None) -> "TendonSpec":
+        """A tendon through every link from ``origin`` (default: the base link) to ``insertion``."""
+        names = spec.joint_names
+        origin = origin or spec.base_link
+        for link in (origin, insertion):
+            if link not in names:
+                raise ValueError(f"tendon {name!r}: unknown link {link!r}; links are {list(names)}")
+        i, j = names.index(insertion), names.index(origin)
+        if i > j:
+            raise ValueError(f"tendon {name!r}: insertion {insertion!r} is caudal of origin {origin!r}")
+        return cls(name, side, tuple(reversed(names[i:j + 1])))
+
+
+@dataclasses.dataclass(frozen=True)
+class TendonLayout:
+    """An ordered set of tendons; the order is the order of the actions."""
+    tendons: tuple[TendonSpec, ...]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(t.name for t in self.tendons)
+
+    def __len__(self) -> int:
+        return len(self.tendons)
+
+    # Default insertions of the 8 ventral tendons, caudal to cranial.  The paper
+    # follows the ventral neck muscles of the ostrich (Cobley et al., 2013), whose
+    # slips insert along the whole neck; we insert one tendon at every second
+    # vertebra from C16 to C2, so each one adds flexion torque to a further
+    # stretch of the neck.  Contracting them one after another moves the bend
+    # along the neck (rolling pattern); the C2 tendon reaches the head joint
+    # region and so steers the head's attitude.
+    ROBOSTRICH_VENTRAL_INSERTIONS = ("c16", "c14", "c12", "c10", "c8", "c6", "c4", "c2")
+
+    @classmethod
+    def robostrich(cls, spec: ArmSpec | None = None) -> "TendonLayout":
+        """The paper's layout: 1 dorsal tendon to the head + 8 ventral tendons."""
+        spec = spec or ArmSpec.from_table1()
+        dorsal = TendonSpec.spanning("dorsal", "dorsal", spec.head_name, spec)
+        ventral = [TendonSpec.spanning(f"ventral_{link}", "ventral", link, spec)
+                   for link in cls.ROBOSTRICH_VENTRAL_INSERTIONS]
+        return cls((dorsal, *ventral))
+
+    def validate(self, spec: ArmSpec) -> None:
+        """Raise ``ValueError`` naming the first bad tendon."""
+        if not self.tendons:
+            raise ValueError("a tendon layout needs at least one tendon")
+        order = {name: i for i, name in enumerate(reversed(spec.joint_names))}  # caudal = 0
+        seen = set()
+        for tendon in self.tendons:
+            if not tendon.name or not isinstance(tendon.name, str):
+                raise ValueError(f"tendon name must be a non-empty string, got {tendon.name!r}")
+            if tendon.name in seen:
+                raise ValueError(f"duplicate tendon name {tendon.name!r}")
+            seen.add(tendon.name)
+            if tendon.side not in SIDES:
+                raise ValueError(f"tendon {tendon.name!r}: unknown side {tendon.side!r}; "
+                                 f"use one of {SIDES}")
+            if len(tendon.links) < 2:
+                raise ValueError(f"tendon {tendon.name!r} runs through {len(tendon.links)} hole(s);"
+                                 " a tendon needs at least two")
+            for link in tendon.links:
+                if link not in order:
+                    raise ValueError(f"tendon {tendon.name!r} runs through unknown link {link!r}; "
+                                     f"links are {list(spec.joint_names)}")
+            ranks = [order[link] for link in tendon.links]
+            if any(b <= a for a, b in zip(ranks, ranks[1:])):
+                raise ValueError(f"tendon {tendon.name!r}: links {list(tendon.links)} must run "
+                                 "from caudal to cranial without repeats")
+
+
+def _hole_site_name(link: str, side: str) -> str:
+    return f"{link}_{side}_hole"
+
+
+def _anchor_site_name(tendon: str) -> str:
+    return f"{tendon}_anchor"
+
+
+def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -> mjcf.RootElement:
+    """Return the arm as an ``mjcf`` model rooted at a fixed ``base`` body.
+
+    Attach it to a frame or a robot with ``site.attach(build_arm())``; all names
+    are then prefixed ``arm/``.  The base body holds the tendon anchors.
+    """
+    spec = ArmSpec.from_table1() if spec is None else spec
+    spec.validate()
+    layout = TendonLayout.robostrich(spec) if layout is None else layout
+    layout.validate(spec)
+
+    model = mjcf.RootElement(model=ARM_MODEL_NAME)
+    model.compiler.angle = "radian"
+    model.option.integrator = "implicitfast"
+    model.option.timestep = 0.002
+    link_default = model.default.add("default", dclass="link")
+    link_default.geom.set_attributes(type="capsule", size=[spec.link_radius],
+                                     contype=COLLISION_TYPE, conaffinity=0,
+                                     rgba=[0.85, 0.8, 0.7, 1])
+    link_default.joint.set_attributes(type="hinge", axis=[0, 1, 0], limited=True,
+                                      stiffness=spec.joint_stiffness, damping=spec.joint_damping,
+                                      armature=spec.joint_armature, springref=0,
+                                      solreflimit=spec.limit_solref,
+                                      solimplimit=spec.limit_solimp)
+    link_default.site.set_attributes(type="sphere", size=[0.002], rgba=[0.2, 0.2, 0.9, 1])
+    tendon_default = model.default.add("default", dclass="tendon")
+    tendon_default.tendon.set_attributes(width=0.0015)
+    tendon_default.general.set_attributes(
+        gaintype="fixed", biastype="affine", ctrllimited=True, forcelimited=True,
+        forcerange=[-spec.tendon_max_force, 0.0])
+
+    base = model.worldbody.add("body", name="base")
+    base.add("geom", name="base_plate", type="box", size=[0.03, 0.02, 0.005],
+             pos=[0, 0, -spec.anchor_depth - 0.005], contype=COLLISION_TYPE, conaffinity=0,
+             rgba=[0.3, 0.3, 0.3, 1], mass=0.05)
+    side_x = {"dorsal": -spec.hole_offset, "ventral": spec.hole_offset}
+
+    # Build the chain caudal -> cranial: the base link's joint sits at the base origin.
+    joint_range = dict(zip(spec.joint_names, spec.joint_range_rad()))
+    masses = dict(zip(spec.joint_names, spec.masses))
+    lengths = dict(zip(spec.joint_names[1:], spec.link_lengths))
+    parent, pos = base, 0.0
+    for name in reversed(spec.joint_names):
+        body = parent.add("body", name=name, pos=[0, 0, pos], childclass="link")
+        body.add("joint", name=name, range=joint_range[name])
+        length = lengths.get(name, spec.head_length)
+        if name == spec.head_name:
+            body.add("geom", name=f"{name}_geom", fromto=[0, 0, 0, 0, 0, length],
+                     size=[spec.link_radius * 1.6], mass=masses[name], rgba=[0.9, 0.6, 0.3, 1])
+            head_site = body.add("site", name=HEAD_SITE,
+                                 pos=[0, 0, spec.head_site_fraction * length],
+                                 size=[0.004], rgba=[1, 0, 0, 1])
+            model.sensor.add("framelinvel", name=HEAD_VELOCITY_SENSOR, objtype="site",
+                             objname=head_site)
+        else:
+            body.add("geom", name=f"{name}_geom", fromto=[0, 0, 0, 0, 0, length], mass=masses[name])
+        for side in SIDES:
+            body.add("site", name=_hole_site_name(name, side),
+                     pos=[side_x[side], 0, spec.hole_fraction * length])
+        parent, pos = body, length
+
+    for tendon in layout.tendons:
+        anchor = base.add("site", name=_anchor_site_name(tendon.name),
+                          pos=[side_x[tendon.side], 0, -spec.anchor_depth],
+                          size=[0.003], rgba=[0.2, 0.7, 0.2, 1])
+        element = model.tendon.add("spatial", name=tendon.name, dclass="tendon",
+                                   rgba=[0.1, 0.5, 0.9, 1] if tendon.side == "ventral"
+                                   else [0.9, 0.2, 0.2, 1])
+        element.add("site", site=anchor)
+        for link in tendon.links:
+            element.add("site", site=_hole_site_name(link, tendon.side))
+
+    _add_tendon_servos(model, spec, layout)
+    return model
+
+
+def _add_tendon_servos(model: mjcf.RootElement, spec: ArmSpec, layout: TendonLayout) -> None:
+    """One pull-only contraction servo per tendon, ranges derived from the joint limits.
+
+    The rest length is the tendon's length in the straight pose.  The largest
+    useful contraction is the shortening at the side's own joint limits; the
+    largest release is the lengthening at the opposite limits.
+    """
+    physics = mjcf.Physics.from_mjcf_model(model)
+    joint_names = list(spec.joint_names)
+    tendon_names = list(layout.names)
+    rest = np.array(physics.named.data.ten_length[tendon_names])
+    limits = spec.joint_range_rad()
+
+    def lengths_at(qpos):
+        with physics.reset_context():
+            physics.named.data.qpos[joint_names] = qpos
+        return np.array(physics.named.data.ten_length[tendon_names])
+
+    at_dorsal, at_ventral = lengths_at(limits[:, 0]), lengths_at(limits[:, 1])
+    kp, kv = spec.tendon_kp, spec.tendon_kv
+    for tendon, rest_length, dorsal_len, ventral_len in zip(layout.tendons, rest, at_dorsal,
+                                                           at_ventral):
+        own, other = (ventral_len, dorsal_len) if tendon.side == "ventral" else (dorsal_len,
+                                                                                 ventral_len)
+        max_contraction = max(rest_length - own, 1e-3)
+        max_release = max(other - rest_length, 1e-3)
+        model.actuator.add(
+            "general", name=tendon.name, tendon=tendon.name, dclass="tendon",
+            ctrlrange=[-round(max_release, 4), round(max_contraction, 4)],
+            gainprm=[-kp], biasprm=[kp * rest_length, -kp, -kv])
+
+
+def build_frame_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None,
+                    base_height: float = 0.05) -> mjcf.RootElement:
+    """The arm on an immobile frame (the paper's first setup), neck pointing up.
+
+    The frame's top carries the arm's base; the base link's joint is at
+    ``(0, 0, base_height + anchor_depth)`` in the world.
+    """
+    spec = spec or ArmSpec.from_table1()
+    arena = mjcf.RootElement(model="robostrich")
+    arena.compiler.angle = "radian"
+    arena.option.timestep = 0.002
+    arena.option.integrator = "implicitfast"
+    arena.visual.headlight.set_attributes(ambient=[0.4, 0.4, 0.4], diffuse=[0.6, 0.6, 0.6])
+    arena.asset.add("texture", name="grid", type="2d", builtin="checker", width=256, height=256,
+                    rgb1=[0.2, 0.3, 0.4], rgb2=[0.25, 0.35, 0.45])
+    arena.asset.add("material", name="grid", texture="grid", texrepeat=[8, 8], reflectance=0.1)
+    arena.worldbody.add("light", pos=[0, -1, 2], dir=[0, 1, -1])
+    arena.worldbody.add("geom", name="floor", type="plane", size=[2, 2, 0.05], material="grid",
+                        pos=[0, 0, -0.4])
+    arena.worldbody.add("geom", name="frame_post", type="box", size=[0.02, 0.04, 0.2],
+                        pos=[-0.02, 0, base_height - 0.2], rgba=[0.4, 0.4, 0.45, 1])
+    arena.worldbody.add("camera", name="side", pos=[0.25, -1.4, 0.35], xyaxes=[1, 0, 0, 0, 0, 1])
+    mount = arena.worldbody.add("site", name="arm_mount",
+                                pos=[0, 0, base_height + spec.anchor_depth], size=[0.005])
+    mount.attach(build_arm(spec, layout))
+    return arena
+
+
+HEAD_SITE_PATH = f"{ARM_MODEL_NAME}/{HEAD_SITE}"
+
+
+def head_velocity(physics) -> np.ndarray:
+    """World linear velocity (x, y, z) of the head site."""
+    return np.array(physics.named.data.sensordata[f"{ARM_MODEL_NAME}/{HEAD_VELOCITY_SENSOR}"])
+
+
+def head_position(physics) -> np.ndarray:
+    """World position (x, y, z) of the head site of an attached arm."""
+    return np.array(physics.named.data.site_xpos[HEAD_SITE_PATH])
+
+
+def head_axis(physics) -> np.ndarray:
+    """World direction of the head's long axis (the head body's z axis)."""
+    site_id = physics.model.name2id(HEAD_SITE_PATH, "site")
+    body_id = physics.model.site_bodyid[site_id]
+    return np.array(physics.data.xmat[body_id]).reshape(3, 3)[:, 2]
+
+
+def head_attitude_deg(physics) -> float:
+    """Head attitude in the world's x-z plane: 0 up, 90 level (paper Fig. 2B), 180 down."""
+    axis = head_axis(physics)
+    return float(np.degrees(np.arctan2(axis[0], axis[2])))
+
+
+def reach(spec: ArmSpec) -> float:
+    """Distance from the base joint to the head site with the neck straight (m): no
+    pose puts the head farther from the base joint than this."""
+    return float(sum(spec.link_lengths) + spec.head_site_fraction * spec.head_length)

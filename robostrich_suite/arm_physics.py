@@ -1,0 +1,106 @@
+"""Named accessors for an attached Robostrich arm, shared by every domain.
+
+Mixed into each domain's ``Physics`` so tasks read the head, joints and
+tendons by meaning rather than by index.  Joint angles come in Table 1 order
+(atlas first, C18 last); tendons in actuator (= action) order.
+"""
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+from dm_control.rl import control
+
+from robostrich_suite import arm as arm_lib
+
+_PREFIX = arm_lib.ARM_MODEL_NAME + "/"
+
+
+class ArmPhysicsMixin:
+    """Accessors for the arm's head, joints and tendons, plus divergence capture."""
+
+    divergence: str | None = None
+
+    # Indices are looked up once per model; the model never changes under a Physics.
+    def _arm_indices(self):
+        cache = self.__dict__.get("_arm_index_cache")
+        if cache is None or cache[0] is not self.model.ptr:
+            model = self.model
+            joints = [i for i in range(model.njnt)
+                      if model.id2name(i, "joint").startswith(_PREFIX)
+                      and model.jnt_type[i] == 3]  # hinge
+            joints = joints[::-1]  # generator adds caudal first; Table 1 is cranial first
+            actuators = [i for i in range(model.nu)
+                         if model.id2name(i, "actuator").startswith(_PREFIX)]
+            tendons = [int(model.actuator_trnid[i, 0]) for i in actuators]
+            cache = (model.ptr, np.array([model.jnt_qposadr[j] for j in joints]),
+                     np.array([model.jnt_dofadr[j] for j in joints]),
+                     np.array(actuators), np.array(tendons))
+            self.__dict__["_arm_index_cache"] = cache
+        return cache[1:]
+
+    def arm_joint_names(self) -> list[str]:
+        qpos_adr = self._arm_indices()[0]
+        return [self.model.id2name(int(np.where(self.model.jnt_qposadr == a)[0][0]), "joint")
+                for a in qpos_adr]
+
+    def tendon_names(self) -> list[str]:
+        return [self.model.id2name(int(i), "actuator") for i in self._arm_indices()[2]]
+
+    def head_position(self) -> np.ndarray:
+        """Head site position (x, y, z) in metres, world frame."""
+        return arm_lib.head_position(self)
+
+    def head_velocity(self) -> np.ndarray:
+        """Head site linear velocity (x, y, z) in m/s, world frame."""
+        return arm_lib.head_velocity(self)
+
+    def head_attitude(self) -> float:
+        """Head attitude in degrees: 90 = head parallel to the ground (paper Fig. 2B)."""
+        return arm_lib.head_attitude_deg(self)
+
+    def joint_angles(self) -> np.ndarray:
+        """The 18 joint angles (rad), atlas first; positive = ventral flexion."""
+        return self.data.qpos[self._arm_indices()[0]].copy()
+
+    def joint_velocities(self) -> np.ndarray:
+        return self.data.qvel[self._arm_indices()[1]].copy()
+
+    def tendon_lengths(self) -> np.ndarray:
+        """Current length of each actuated tendon (m), in action order."""
+        return self.data.ten_length[self._arm_indices()[3]].copy()
+
+    def tendon_rest_lengths(self) -> np.ndarray:
+        """Length of each tendon in the straight pose (m): the servo's zero contraction."""
+        actuators = self._arm_indices()[2]
+        kp_rest = self.model.actuator_biasprm[actuators, 0]
+        return kp_rest / -self.model.actuator_gainprm[actuators, 0]
+
+    def tendon_contractions(self) -> np.ndarray:
+        """How much each tendon is shorter than at rest (m)."""
+        return self.tendon_rest_lengths() - self.tendon_lengths()
+
+    def tendon_forces(self) -> np.ndarray:
+        """Pull in each tendon (N, >= 0), in action order."""
+        return -self.data.actuator_force[self._arm_indices()[2]].copy()
+
+    def arm_control(self) -> np.ndarray:
+        return self.data.ctrl[self._arm_indices()[2]].copy()
+
+    def step(self, nstep: int = 1) -> None:
+        """Step, but turn a divergence into a flag the task ends the episode on."""
+        if self.divergence is not None:
+            return
+        try:
+            super().step(nstep)
+        except control.PhysicsError as error:
+            self.divergence = str(error)
+        else:
+            if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
+                self.divergence = "non-finite joint state"
+        if self.divergence is not None:
+            logging.warning("physics diverged, ending the episode: %s", self.divergence)
+
+    def reset(self, keyframe_id=None):
+        self.divergence = None
+        return super().reset(keyframe_id)

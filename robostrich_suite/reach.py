@@ -1,0 +1,220 @@
+"""Reaching tasks for any domain whose Physics has the arm accessors.
+
+``Reach`` is one curriculum lesson (paper Sec. 3.2): lesson 1 rewards only the
+position (eq. 9); lessons 2 and 3 reward position and head attitude (eq. 10).
+They differ in how an episode starts:
+
+* ``"fixed"``: the straight, upright pose at rest (lessons 1 and 2);
+* ``"continue"``: the final state of the previous episode (lesson 3), so the
+  agent learns to move between targets; the first episode, and any episode
+  after a divergence, starts fixed.
+
+``Track`` is the evaluation task of Fig. 7: a sequence of targets reached in
+order, one after another, within one episode.
+
+Actions are tendon contractions (m); values outside the action spec are
+clipped to it, a NaN action raises ``ValueError``.  A physics divergence ends
+the episode (discount 0) and is logged, instead of raising from the step.
+"""
+from __future__ import annotations
+
+import collections
+
+import numpy as np
+from dm_control.suite import base
+
+from robostrich_suite import rewards
+
+POSITION_TOLERANCE = 0.05  # m (paper Sec. 4.2)
+ATTITUDE_TOLERANCE = 5.0  # deg
+DESIRED_ATTITUDE = 90.0  # deg: head parallel to the ground
+INITIAL_STATES = ("fixed", "continue")
+REWARDS = ("lesson1", "lesson2")
+
+
+def check_action(action: np.ndarray, physics) -> np.ndarray:
+    """Reject NaN/inf actions; clip the rest into the actuators' control range."""
+    action = np.asarray(action, dtype=np.float64)
+    if not np.all(np.isfinite(action)):
+        bad = np.flatnonzero(~np.isfinite(action)).tolist()
+        raise ValueError(f"action has non-finite values at indices {bad}: {action}")
+    low, high = physics.model.actuator_ctrlrange.T
+    return np.clip(action, low, high)
+
+
+class Reach(base.Task):
+    """Bring the head to a target position (and, from lesson 2, hold it level)."""
+
+    def __init__(self, reward: str = "lesson2", initial_state: str = "fixed",
+                 target_pool=None, position_tolerance: float = POSITION_TOLERANCE,
+                 attitude_tolerance: float = ATTITUDE_TOLERANCE,
+                 desired_attitude: float = DESIRED_ATTITUDE,
+                 weights: rewards.RewardWeights | dict | None = None,
+                 target_axes=(0, 2), random=None):
+        """
+        Args:
+          reward: ``"lesson1"`` (eq. 9) or ``"lesson2"`` (eq. 10).
+          initial_state: ``"fixed"`` or ``"continue"`` (see the module doc).
+          target_pool: (n, 2) head positions (x, z) to draw targets from; defaults
+            to :func:`robostrich_suite.targets.training_targets`.
+          position_tolerance, attitude_tolerance: d (m) and a (deg) of eqs. 9-10.
+          desired_attitude: head attitude to hold (deg; 90 = level).
+          weights: lambda_1..lambda_4 (a ``RewardWeights`` or a dict of its fields).
+          target_axes: world axes of the head position the targets are given in.
+        """
+        if reward not in REWARDS:
+            raise ValueError(f"unknown reward {reward!r}; use one of {REWARDS}")
+        if initial_state not in INITIAL_STATES:
+            raise ValueError(f"unknown initial_state {initial_state!r}; use one of {INITIAL_STATES}")
+        if target_pool is None:
+            from robostrich_suite import targets
+            target_pool = targets.training_targets()
+        target_pool = np.asarray(target_pool, dtype=np.float64).reshape(-1, 2)
+        if len(target_pool) == 0 or not np.all(np.isfinite(target_pool)):
+            raise ValueError("target_pool must be a non-empty (n, 2) array of finite positions")
+        if isinstance(weights, dict):
+            weights = rewards.RewardWeights(**weights)
+        self.reward_name = reward
+        self.initial_state = initial_state
+        self.target_pool = target_pool
+        self.position_tolerance = float(position_tolerance)
+        self.attitude_tolerance = float(attitude_tolerance)
+        self.desired_attitude = float(desired_attitude)
+        self.weights = weights or rewards.RewardWeights()
+        self.target_axes = tuple(target_axes)
+        self.target_position = target_pool[0].copy()
+        self._last_state = None
+        super().__init__(random=random)
+
+    # --- episode structure -------------------------------------------------
+    def initialize_episode(self, physics):
+        if self.initial_state == "continue" and self._last_state is not None:
+            qpos, qvel, act = self._last_state
+            with physics.reset_context():
+                physics.data.qpos[:] = qpos
+                physics.data.qvel[:] = qvel
+                if act.size:
+                    physics.data.act[:] = act
+        self.target_position = self.next_target()
+        super().initialize_episode(physics)
+
+    def next_target(self) -> np.ndarray:
+        return self.target_pool[self.random.randint(len(self.target_pool))].copy()
+
+    def before_step(self, action, physics):
+        physics.set_control(check_action(action, physics))
+
+    def after_step(self, physics):
+        # Remember where the arm is for the next episode of a "continue" lesson.
+        if physics.divergence is None:
+            self._last_state = (physics.data.qpos.copy(), physics.data.qvel.copy(),
+                                physics.data.act.copy())
+        else:
+            self._last_state = None
+
+    def get_termination(self, physics):
+        if physics.divergence is not None:
+            return 0.0
+        return None
+
+    # --- measurements ------------------------------------------------------
+    def head_xz(self, physics) -> np.ndarray:
+        return physics.head_position()[list(self.target_axes)]
+
+    def position_error(self, physics) -> float:
+        return float(np.linalg.norm(self.target_position - self.head_xz(physics)))
+
+    def attitude_error(self, physics) -> float:
+        """Signed head attitude error in degrees (positive = head pitched down)."""
+        return physics.head_attitude() - self.desired_attitude
+
+    def is_success(self, physics) -> bool:
+        return (self.position_error(physics) <= self.position_tolerance
+                and abs(self.attitude_error(physics)) <= self.attitude_tolerance)
+
+    # --- dm_control Task API ------------------------------------------------
+    def get_observation(self, physics):
+        """Table 2 (head position, head velocity, joint angles) + goal + tendon state.
+
+        Units are chosen so that every entry is of order one: metres, m/s,
+        radians, and tendon forces as a fraction of the actuator's limit.
+        """
+        obs = collections.OrderedDict()
+        head = self.head_xz(physics)
+        obs["head_position"] = head
+        obs["head_velocity"] = physics.head_velocity()[list(self.target_axes)]
+        obs["joint_angles"] = physics.joint_angles()
+        obs["target_position"] = self.target_position.copy()
+        obs["to_target"] = self.target_position - head
+        attitude_error = self.attitude_error(physics)
+        obs["attitude_error"] = np.array([np.radians(attitude_error)])
+        obs["head_attitude"] = np.array([np.radians(physics.head_attitude())])
+        obs["tendon_contraction"] = physics.tendon_contractions()
+        obs["tendon_tension"] = physics.tendon_forces() / self._max_forces(physics)
+        return obs
+
+    def _max_forces(self, physics):
+        return -physics.model.actuator_forcerange[physics._arm_indices()[2], 0]
+
+    def get_reward(self, physics):
+        if physics.divergence is not None:
+            return -2.0 if self.reward_name == "lesson1" else -2.0 * (
+                self.weights.position_miss + self.weights.attitude_miss)
+        error = self.position_error(physics)
+        if self.reward_name == "lesson1":
+            return rewards.lesson1_reward(error, self.position_tolerance)
+        return rewards.lesson2_reward(error, self.attitude_error(physics),
+                                      self.position_tolerance, self.attitude_tolerance,
+                                      self.weights)
+
+
+class Track(Reach):
+    """Reach ``targets`` in order, ``steps_per_target`` control steps each (Fig. 7)."""
+
+    def __init__(self, targets=None, steps_per_target: int = 250, **kwargs):
+        if targets is None:
+            from robostrich_suite import targets as targets_lib
+            targets = default_track_targets(targets_lib.heldout_targets())
+        targets = np.asarray(targets, dtype=np.float64).reshape(-1, 2)
+        if steps_per_target < 1:
+            raise ValueError(f"steps_per_target must be >= 1, got {steps_per_target}")
+        kwargs.setdefault("reward", "lesson2")
+        super().__init__(target_pool=targets, **kwargs)
+        self.targets = targets
+        self.steps_per_target = int(steps_per_target)
+        self.target_index = 0
+        self._step = 0
+
+    def initialize_episode(self, physics):
+        self._step = 0
+        self.target_index = 0
+        super().initialize_episode(physics)
+
+    def next_target(self) -> np.ndarray:
+        return self.targets[self.target_index].copy()
+
+    def after_step(self, physics):
+        super().after_step(physics)
+        self._step += 1
+        index = min(self._step // self.steps_per_target, len(self.targets) - 1)
+        if index != self.target_index:
+            self.target_index = index
+            self.target_position = self.targets[index].copy()
+
+    def get_observation(self, physics):
+        obs = super().get_observation(physics)
+        obs["position_error"] = np.array([self.position_error(physics)])
+        obs["target_index"] = np.array([float(self.target_index)])
+        return obs
+
+
+def default_track_targets(pool: np.ndarray, count: int = 3) -> np.ndarray:
+    """Three well-separated targets from ``pool``: far forward-low, high, and middle.
+
+    Deterministic, so every evaluation of ``track`` sees the same sequence.
+    """
+    pool = np.asarray(pool)
+    order = [np.argmax(pool[:, 0] - pool[:, 1]),  # forward and low
+             np.argmax(pool[:, 1]),  # highest
+             np.argmin(np.linalg.norm(pool - pool.mean(0), axis=1))]  # central
+    return pool[order[:count]]

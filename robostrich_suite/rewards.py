@@ -1,0 +1,35 @@
+"""The curriculum's reward functions (paper eqs. 9 and 10), as plain functions."""
+from __future__ import annotations
+
+import dataclasses
+
+
+@dataclasses.dataclass(frozen=True)
+class RewardWeights:
+    """lambda_1..lambda_4 of eq. 10.
+
+    ``position_miss`` and ``attitude_miss`` weigh the indicator terms (being
+    outside the tolerance); ``position_error`` (per metre) and
+    ``attitude_error`` (per degree) weigh the shaping terms.  The defaults make
+    a 0.1 m miss and a 10 deg miss cost about the same.
+    """
+    position_miss: float = 1.0
+    attitude_miss: float = 1.0
+    position_error: float = 2.0
+    attitude_error: float = 0.02
+
+
+def lesson1_reward(position_error: float, position_tolerance: float) -> float:
+    """Eq. 9: -1 while the head is farther than ``d`` from the target, else 0."""
+    return -float(position_error > position_tolerance)
+
+
+def lesson2_reward(position_error: float, attitude_error_deg: float, position_tolerance: float,
+                   attitude_tolerance_deg: float, weights: RewardWeights = RewardWeights()
+                   ) -> float:
+    """Eq. 10: r_m2 + r_a2, indicator misses plus weighted absolute errors."""
+    attitude_error_deg = abs(attitude_error_deg)
+    r_m2 = (-weights.position_miss * float(position_error > position_tolerance)
+            - weights.attitude_miss * float(attitude_error_deg > attitude_tolerance_deg))
+    r_a2 = -weights.position_error * position_error - weights.attitude_error * attitude_error_deg
+    return r_m2 + r_a2

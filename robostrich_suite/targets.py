@@ -1,0 +1,98 @@
+"""Targets for the reaching tasks: head positions the arm really holds level.
+
+The paper draws targets from the blue region of Fig. 6 (head attitude 90 +- 5
+deg).  A kinematic sample of that region includes poses a passive chain under
+gravity cannot hold, so we ship instead the level subset of the *actuated*
+workspace (:func:`robostrich_suite.workspace.actuated_samples`): every target
+comes with the tendon inputs that hold the head there, and a test re-simulates
+some of them.  Every fifth pose is held out for evaluation and never used in
+training.
+
+Regenerate after changing the default arm with::
+
+    python -m robostrich_suite.targets --samples 16000
+"""
+from __future__ import annotations
+
+import argparse
+import functools
+import pathlib
+
+import numpy as np
+
+DATA_PATH = pathlib.Path(__file__).parent / "data" / "level_head_poses.npz"
+HELDOUT_EVERY = 5
+
+
+@functools.lru_cache(maxsize=None)
+def _load(path: str = str(DATA_PATH)) -> dict:
+    path = pathlib.Path(path)
+    if not path.exists():
+        raise FileNotFoundError(
+            f"{path} is missing; regenerate it with `python -m robostrich_suite.targets`")
+    with np.load(path) as data:
+        return {key: data[key] for key in data.files}
+
+
+def level_head_poses() -> dict:
+    """All shipped level-head poses: ``head_position`` (n, 2), ``head_attitude`` (n,),
+    ``control`` (n, 9) and the ``fingerprint`` of the arm they were made with."""
+    return _load()
+
+
+def _split(heldout: bool) -> np.ndarray:
+    positions = level_head_poses()["head_position"]
+    mask = (np.arange(len(positions)) % HELDOUT_EVERY == 0)
+    return positions[mask if heldout else ~mask].copy()
+
+
+def training_targets() -> np.ndarray:
+    """(n, 2) target positions (x, z) the training tasks sample from."""
+    return _split(heldout=False)
+
+
+def heldout_targets() -> np.ndarray:
+    """(n, 2) target positions (x, z) kept out of training, for evaluation."""
+    return _split(heldout=True)
+
+
+def generate(num_samples: int, seed: int = 0, path: pathlib.Path = DATA_PATH,
+             workers: int = 2) -> int:
+    """Sample the actuated workspace and save its level subset; returns its size."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from robostrich_suite import workspace
+    chunk = -(-num_samples // workers)
+    with ProcessPoolExecutor(workers) as pool:
+        parts = list(pool.map(_sample_chunk, [(chunk, seed + i, i == 0) for i in range(workers)]))
+    samples = workspace.ActuatedSamples(*(np.concatenate([getattr(p, f) for p in parts])
+                                          for f in ("head_position", "head_attitude", "control",
+                                                    "settled")))
+    level = samples.level()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(path, head_position=samples.head_position[level],
+                        head_attitude=samples.head_attitude[level],
+                        control=samples.control[level],
+                        fingerprint=np.array(workspace.model_fingerprint()))
+    _load.cache_clear()
+    return int(level.sum())
+
+
+def _sample_chunk(args):
+    from robostrich_suite import workspace
+    num, seed, progress = args
+    return workspace.actuated_samples(num, seed=seed, progress=progress)
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--samples", type=int, default=16000)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=pathlib.Path, default=DATA_PATH)
+    args = parser.parse_args(argv)
+    count = generate(args.samples, args.seed, args.out)
+    print(f"wrote {count} level-head poses to {args.out}")
+
+
+if __name__ == "__main__":
+    main()
