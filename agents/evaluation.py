@@ -19,7 +19,7 @@ def rollout(env, actor, flattener, recorder=None) -> dict:
     """One episode with `actor`; per-step series of errors, head pose, target and action."""
     timestep = env.reset()
     physics = env.physics
-    has_head = hasattr(physics, "head_position")
+    has_head = probes.head_xz(env) is not None
     series = {k: [] for k in ("time", "position_error", "attitude_error", "head_position", "head_attitude",
                               "target", "action", "reward")}
     if recorder is not None:
@@ -34,7 +34,7 @@ def rollout(env, actor, flattener, recorder=None) -> dict:
         series["reward"].append(float(timestep.reward))
         series["action"].append(np.asarray(action, np.float64).tolist())
         if has_head:
-            series["head_position"].append(np.asarray(physics.head_position(), np.float64).tolist())
+            series["head_position"].append(probes.head_xz(env).tolist())
             series["head_attitude"].append(float(physics.head_attitude()))
             series["target"].append(np.asarray(env.task.target_position, np.float64).tolist())
         if recorder is not None:

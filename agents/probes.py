@@ -11,23 +11,26 @@ LEVEL_ATTITUDE = 90.0  # deg
 
 
 def head_errors(env):
-    """(position error m, attitude error deg) of the current state; NaN where the env cannot tell.
+    """(position error m, |attitude error| deg) of the current state; NaN where the env cannot tell.
 
-    robostrich: physics.head_position()/head_attitude() against task.target_position
-    (and task.target_attitude if the task has one, else 90 deg). dm_control's point_mass
-    is supported for development (attitude error 0).
+    robostrich: the task's own `position_error(physics)` / `attitude_error(physics)`
+    (robostrich_suite.reach.Reach). dm_control's point_mass is supported for
+    development (attitude error 0).
     """
     physics, task = env.physics, env.task
-    if hasattr(physics, "head_position") and hasattr(task, "target_position"):
-        pos = np.asarray(physics.head_position(), np.float64)
-        target = np.asarray(task.target_position, np.float64)
-        position_error = float(np.linalg.norm(pos - target))
-        attitude_target = float(getattr(task, "target_attitude", LEVEL_ATTITUDE))
-        attitude_error = float(abs(float(physics.head_attitude()) - attitude_target))
-        return position_error, attitude_error
+    if hasattr(task, "position_error") and hasattr(task, "attitude_error"):
+        return float(task.position_error(physics)), float(abs(task.attitude_error(physics)))
     if hasattr(physics, "mass_to_target_dist"):
         return float(physics.mass_to_target_dist()), 0.0
     return float("nan"), float("nan")
+
+
+def head_xz(env):
+    """The head position in the arm's plane (x, z), or None for other domains."""
+    task = env.task
+    if hasattr(task, "head_xz"):
+        return np.asarray(task.head_xz(env.physics), np.float64)
+    return None
 
 
 def is_success(position_error, attitude_error) -> bool:

@@ -1,8 +1,8 @@
 """Rerun recordings: evaluation rollouts (arm, head path, targets, tendon inputs, errors) and training curves.
 
-The arm itself is drawn by `robostrich_suite.rerun_log` when the simulation
-package provides it; other dm_control domains fall back to their body
-positions as a line strip (development only).
+The arm itself is drawn by `robostrich_suite.rerun_log` (its geoms as 3D
+shapes, body poses per step); other dm_control domains fall back to their
+body positions as a line strip (development only).
 """
 from typing import Dict, List
 
@@ -30,16 +30,18 @@ class RolloutRecorder:
         self._arm_logger_checked = False
 
     def _log_arm(self, env):
+        """Arm shapes via robostrich_suite.rerun_log (geometry once, body poses per step)."""
+        physics = env.physics
         if not self._arm_logger_checked:
             self._arm_logger_checked = True
             try:
                 from robostrich_suite import rerun_log
                 self._arm_logger = rerun_log
+                rerun_log.log_geometry(self.rec, physics)
             except ImportError:
                 self._arm_logger = None
-        physics = env.physics
-        if self._arm_logger is not None and hasattr(physics, "head_position"):
-            log_physics(self._arm_logger, self.rec, physics)
+        if self._arm_logger is not None:
+            self._arm_logger.log_body_poses(self.rec, physics)
         else:
             xpos = np.asarray(physics.data.xpos[1:], np.float64)
             self.rec.log("world/arm", rr.LineStrips3D([xpos], radii=0.005))
@@ -79,19 +81,6 @@ class RolloutRecorder:
                          static=True)
         self.rec.flush()
         self.rec.disconnect()
-
-
-def log_physics(rerun_log_module, rec, physics):
-    """Adapter around robostrich_suite.rerun_log (its API is looked up, not assumed)."""
-    for name in ("log_arm", "log_physics", "log_state"):
-        fn = getattr(rerun_log_module, name, None)
-        if fn is not None:
-            try:
-                fn(physics, recording=rec)
-            except TypeError:
-                fn(rec, physics)
-            return
-    raise AttributeError(f"robostrich_suite.rerun_log has none of log_arm/log_physics/log_state")
 
 
 CURVE_FIELDS = ("return", "success", "position_error", "attitude_error", "critic_loss", "actor_loss",
