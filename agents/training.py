@@ -78,8 +78,11 @@ def build_parser():
     p.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
                    help="also train plain SAC on the final lesson with the same total budget")
     p.add_argument("--eval-every", type=int, default=None, help="held-out evaluation period (default: steps/6)")
-    p.add_argument("--num-eval-targets", type=int, default=None, help="held-out targets per evaluation (default all)")
-    p.add_argument("--heldout-task", default=None, help="task for held-out evaluation (default: the final lesson)")
+    p.add_argument("--num-eval-targets", type=int, default=20,
+                   help="held-out targets in the periodic evaluations (the final one uses all)")
+    p.add_argument("--heldout-task", default=None,
+                   help="task for held-out evaluation (default: lesson2 on robostrich, i.e. eq. 10 from the "
+                        "fixed initial pose; else the final lesson)")
     p.add_argument("--track-task", default="track")
     p.add_argument("--no-rerun", action="store_true")
     p.add_argument("--no-figures", action="store_true")
@@ -131,7 +134,7 @@ def main(argv=None):
     total = sum(l.steps for l in plan)
     final = plan[-1]
     domain = final.domain
-    heldout_task = args.heldout_task or final.task
+    heldout_task = args.heldout_task or ("lesson2" if domain in ROBOSTRICH_DOMAINS else final.task)
     track_task = args.track_task if domain in ROBOSTRICH_DOMAINS else None
     run_plans = {"curriculum": plan}
     if args.baseline:
@@ -191,7 +194,8 @@ def main(argv=None):
     for label, run in runs.items():
         actor = SACBuilder.make_eval_actor(run.loop)
         finals[label] = evaluation.evaluate_agent(actor, run.loop.flattener, out_eval, label, domain, heldout_task,
-                                                  track_task, args.num_eval_targets, env_steps=run.loop.env_steps,
+                                                  track_task, None if domain in ROBOSTRICH_DOMAINS else args.num_eval_targets,
+                                                  env_steps=run.loop.env_steps,
                                                   record=not args.no_rerun)
     metrics = {label: read_jsonl(run.metrics_path) for label, run in runs.items()}
     evals = {label: read_jsonl(run.evals_path) for label, run in runs.items()}

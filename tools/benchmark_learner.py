@@ -1,0 +1,200 @@
+"""Speed of the learner and the environment loop, as ratios against plain versions measured in the same run.
+
+    PYTHONPATH=. python tools/benchmark_learner.py [--domain robostrich --task lesson1] [--hidden 256,256 --batch 256]
+
+Learner: updates/s of the jitted `lax.scan` update (agents.sac.learning) against
+  (a) a plain SAC update written CleanRL-style: each loss jitted on its own,
+      optimiser steps and Polyak averaging as separate calls from Python, one
+      batch sampled and transferred per update;
+  (b) the same plain update without jit (op-by-op dispatch), for scale.
+Environment loop: steps/s of agents.loop.EnvironmentLoop acting with the policy
+(no learning) against a plain loop (eager policy call, dict observations
+flattened with Python lists, transitions appended to a list) and against raw
+env.step with a fixed action.
+"""
+import argparse
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+import jax  # noqa: E402
+import jax.numpy as jnp  # noqa: E402
+import numpy as np  # noqa: E402
+import optax  # noqa: E402
+
+from agents.curriculum import make_environment  # noqa: E402
+from agents.sac.builder import SACBuilder  # noqa: E402
+from agents.sac.config import SACConfig  # noqa: E402
+from agents.sac.learning import SACLearner, Transitions, init_state  # noqa: E402
+from agents.sac.networks import make_networks  # noqa: E402
+
+
+def plain_sac(networks, config):
+    """A straightforward SAC update (same maths, same networks, same batch), no fusing, no scan."""
+    q_opt, pi_opt, a_opt = optax.adam(config.learning_rate), optax.adam(config.learning_rate), optax.adam(config.learning_rate)
+    target_entropy = -float(networks.action_size)
+
+    def critic_loss(q_params, target_q_params, policy_params, alpha, b, key):
+        na, nlp = networks.sample(policy_params, b.next_obs, key)
+        t1, t2 = networks.q_apply(target_q_params, b.next_obs, na)
+        target = jax.lax.stop_gradient(b.reward + config.discount * b.discount * (jnp.minimum(t1, t2) - alpha * nlp))
+        q1, q2 = networks.q_apply(q_params, b.obs, b.action)
+        return 0.5 * (jnp.mean((q1 - target) ** 2) + jnp.mean((q2 - target) ** 2))
+
+    def actor_loss(policy_params, q_params, alpha, obs, key):
+        a, lp = networks.sample(policy_params, obs, key)
+        q1, q2 = networks.q_apply(q_params, obs, a)
+        return jnp.mean(alpha * lp - jnp.minimum(q1, q2)), lp
+
+    def alpha_loss(log_alpha, lp):
+        return jnp.mean(-jnp.exp(log_alpha) * jax.lax.stop_gradient(lp + target_entropy))
+
+    def make(jit):
+        wrap = jax.jit if jit else (lambda f: f)
+        critic_grad = wrap(jax.value_and_grad(critic_loss))
+        actor_grad = wrap(jax.value_and_grad(actor_loss, has_aux=True))
+        alpha_grad = wrap(jax.value_and_grad(alpha_loss))
+        q_update, pi_update, a_update = wrap(q_opt.update), wrap(pi_opt.update), wrap(a_opt.update)
+        apply = wrap(optax.apply_updates)
+        polyak = wrap(lambda new, old: optax.incremental_update(new, old, config.tau))
+
+        def update(s, batch, key):
+            k1, k2 = jax.random.split(key)
+            alpha = jnp.exp(s["log_alpha"])
+            _, g = critic_grad(s["q"], s["target_q"], s["pi"], alpha, batch, k1)
+            u, s["q_opt"] = q_update(g, s["q_opt"], s["q"])
+            s["q"] = apply(s["q"], u)
+            (_, lp), g = actor_grad(s["pi"], s["q"], alpha, batch.obs, k2)
+            u, s["pi_opt"] = pi_update(g, s["pi_opt"], s["pi"])
+            s["pi"] = apply(s["pi"], u)
+            _, g = alpha_grad(s["log_alpha"], lp)
+            u, s["a_opt"] = a_update(g, s["a_opt"], s["log_alpha"])
+            s["log_alpha"] = apply(s["log_alpha"], u)
+            s["target_q"] = polyak(s["q"], s["target_q"])
+            return s
+        return update
+
+    def initial(key):
+        st = init_state(networks, config, key)
+        return {"pi": st.policy_params, "q": st.q_params, "target_q": st.target_q_params,
+                "pi_opt": st.policy_opt_state, "q_opt": st.q_opt_state, "log_alpha": st.log_alpha,
+                "a_opt": st.alpha_opt_state}
+    return make, initial
+
+
+def random_replay(n, obs_size, act_size, rng):
+    return Transitions(rng.normal(size=(n, obs_size)).astype(np.float32),
+                       rng.uniform(-1, 1, (n, act_size)).astype(np.float32),
+                       rng.normal(size=n).astype(np.float32), np.ones(n, np.float32),
+                       rng.normal(size=(n, obs_size)).astype(np.float32))
+
+
+def time_calls(fn, seconds):
+    fn()  # warm-up / compile
+    n, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        fn()
+        n += 1
+    return n, time.perf_counter() - start
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--domain", default="robostrich")
+    p.add_argument("--task", default="lesson1")
+    p.add_argument("--hidden", default="256,256")
+    p.add_argument("--batch", type=int, default=256)
+    p.add_argument("--updates-per-call", type=int, default=8)
+    p.add_argument("--seconds", type=float, default=8.0, help="measuring time per variant")
+    args = p.parse_args(argv)
+    env = make_environment(args.domain, args.task, 0)
+    config = SACConfig(batch_size=args.batch, hidden_sizes=tuple(int(h) for h in args.hidden.split(",")),
+                       updates_per_call=args.updates_per_call, min_replay_size=0)
+    loop = SACBuilder(config).make_components(env, seed=0)
+    obs_size, act_size = loop.flattener.size, loop.actor.adapter.size
+    networks = make_networks(obs_size, act_size, config.hidden_sizes)
+    rng = np.random.default_rng(0)
+    replay = random_replay(100_000, obs_size, act_size, rng)
+    print(f"{args.domain}/{args.task}: obs {obs_size}, action {act_size}, hidden {config.hidden_sizes}, "
+          f"batch {config.batch_size}, jax {jax.__version__} on {jax.devices()[0].platform}")
+
+    # --- learner -----------------------------------------------------------------------
+    learner = SACLearner(networks, config, jax.random.PRNGKey(0))
+    k = config.updates_per_call
+
+    def ours():
+        idx = rng.integers(0, 100_000, (k, config.batch_size))
+        m = learner.step(Transitions(*(x[idx] for x in replay)))
+        m["critic_loss"].block_until_ready()
+
+    make, initial = plain_sac(networks, config)
+    results = {}
+    for name, jit in (("plain_jit_per_loss", True), ("plain_eager", False)):
+        update, state = make(jit), initial(jax.random.PRNGKey(0))
+        key = [jax.random.PRNGKey(1)]
+
+        def plain():
+            idx = rng.integers(0, 100_000, config.batch_size)
+            batch = Transitions(*(jnp.asarray(x[idx]) for x in replay))
+            key[0], sub = jax.random.split(key[0])
+            s = update(state, batch, sub)
+            jax.block_until_ready(s["target_q"])
+        calls, secs = time_calls(plain, args.seconds if jit else min(args.seconds, 4.0))
+        results[name] = calls / secs
+    calls, secs = time_calls(ours, args.seconds)
+    results["ours"] = calls * k / secs
+    print("learner updates/s:")
+    print(f"  ours (one jit, lax.scan x{k})       {results['ours']:9.1f}")
+    print(f"  plain SAC, each loss jitted          {results['plain_jit_per_loss']:9.1f}   "
+          f"ratio ours/plain = {results['ours'] / results['plain_jit_per_loss']:.2f}x")
+    print(f"  plain SAC, no jit                    {results['plain_eager']:9.1f}   "
+          f"ratio ours/eager = {results['ours'] / results['plain_eager']:.1f}x")
+
+    # --- environment loop ----------------------------------------------------------------
+    steps = 3000
+    loop.replay.size = 0  # act with the policy but never learn: measures the acting path only
+    loop.config = SACConfig(**{**config.to_dict(), "min_replay_size": 0, "env_steps_per_call": 10 ** 9,
+                               "hidden_sizes": config.hidden_sizes})
+    loop.run(200)
+    start = time.perf_counter()
+    loop.run(steps)
+    ours_sps = steps / (time.perf_counter() - start)
+
+    policy_apply = networks.policy_apply  # eager haiku apply, the obvious first version
+    params = learner.policy_params
+    transitions = []
+    ts = env.reset()
+    adapter = loop.actor.adapter
+    key = jax.random.PRNGKey(0)
+    start = time.perf_counter()
+    for _ in range(steps // 3):
+        obs = jnp.asarray(np.concatenate([np.ravel(v) for v in ts.observation.values()])[None], jnp.float32)
+        key, sub = jax.random.split(key)
+        mean, log_std = policy_apply(params, obs)
+        a = np.asarray(jnp.tanh(mean + jnp.exp(log_std) * jax.random.normal(sub, mean.shape)))[0]
+        nts = env.step(adapter.to_env(a))
+        transitions.append((ts.observation, a, nts.reward, nts.discount, nts.observation))
+        ts = env.reset() if nts.last() else nts
+    plain_sps = (steps // 3) / (time.perf_counter() - start)
+
+    action = adapter.to_env(np.zeros(act_size))
+    ts = env.reset()
+    start = time.perf_counter()
+    for _ in range(steps):
+        ts = env.step(action)
+        if ts.last():
+            env.reset()
+    raw_sps = steps / (time.perf_counter() - start)
+    print("environment steps/s (acting, no learning):")
+    print(f"  ours (EnvironmentLoop)               {ours_sps:9.1f}")
+    print(f"  plain loop (eager policy, lists)     {plain_sps:9.1f}   ratio ours/plain = {ours_sps / plain_sps:.1f}x")
+    print(f"  raw env.step, fixed action           {raw_sps:9.1f}   ours reaches {ours_sps / raw_sps:.0%} of raw")
+    ud = config.update_to_data_ratio
+    print(f"training throughput estimate at update-to-data {ud:g}: "
+          f"{1.0 / (1.0 / ours_sps + ud / results['ours']):.0f} env steps/s")
+
+
+if __name__ == "__main__":
+    main()
