@@ -1,7 +1,7 @@
 """The main job: curriculum SAC (lessons 1->3) and a plain-SAC baseline, then evaluation, figures and recordings.
 
-    robostrich-train --out runs/main          # defaults: about an hour on a 2-core CPU
-    robostrich-train --out runs/main --resume # continue a killed run from its last checkpoint
+    robostrich-train                               # defaults: writes runs/default, about an hour on 2 CPU cores
+    robostrich-train --out runs/default --resume   # continue a killed run from its last checkpoints
 
 Run directory:
     config.json                  the command line and resolved configuration
@@ -65,7 +65,7 @@ class Progress:
 
 def build_parser():
     p = argparse.ArgumentParser(description="Train curriculum SAC (and a plain-SAC baseline) on the Robostrich arm.")
-    p.add_argument("--out", default="runs/robostrich", help="run directory")
+    p.add_argument("--out", default="runs/default", help="run directory")
     p.add_argument("--resume", action="store_true", help="continue from the checkpoints in --out")
     p.add_argument("--domain", default="robostrich")
     p.add_argument("--steps", type=int, default=DEFAULT_TOTAL_STEPS,
