@@ -170,6 +170,9 @@ class CurriculumRun:
             if progress is not None:
                 progress.on_episode(record)
 
+        def crossed(before, after, period):
+            return after // period > before // period
+
         try:
             while not self.done:
                 lesson = self.plan[self.lesson_index]
@@ -182,19 +185,20 @@ class CurriculumRun:
                     if loop.env_steps >= stop_at_step:
                         raise TrainingInterrupted(f"stopped at step {loop.env_steps}")
                     n = min(n, stop_at_step - loop.env_steps)
-                loop.run(n, on_episode=on_episode)
-                self.lesson_steps += n
+                before = loop.env_steps
+                ran = loop.run(n, on_episode=on_episode)
+                self.lesson_steps += ran
                 if progress is not None:
-                    progress.update(n, self)
+                    progress.update(ran, self)
                 if self.lesson_steps >= lesson.steps:  # next lesson; everything else carries over
                     self.lesson_index += 1
                     self.lesson_steps = 0
                     if not self.done:
                         loop.set_environment(self._make_lesson_env(self.lesson_index))
-                if on_eval is not None and loop.env_steps in eval_at:
+                if on_eval is not None and any(before < s <= loop.env_steps for s in eval_at):
                     metrics_file.flush()
                     on_eval(self)
-                if loop.env_steps % self.checkpoint_every == 0 or self.done:
+                if crossed(before, loop.env_steps, self.checkpoint_every) or self.done:
                     metrics_file.flush()
                     self.save_checkpoint()
         finally:

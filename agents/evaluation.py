@@ -7,6 +7,8 @@ figures and Rerun recordings as the end of a training run.
 import argparse
 import json
 import os
+import shutil
+import tempfile
 from typing import Optional
 
 import numpy as np
@@ -15,8 +17,8 @@ from agents import probes
 from agents.curriculum import ROBOSTRICH_DOMAINS, make_environment
 
 
-def rollout(env, actor, flattener, recorder=None) -> dict:
-    """One episode with `actor`; per-step series of errors, head pose, target and action."""
+def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dict:
+    """One episode with `actor` (acting every `action_repeat` control steps); per-control-step series."""
     timestep = env.reset()
     physics = env.physics
     has_head = probes.head_xz(env) is not None
@@ -24,9 +26,12 @@ def rollout(env, actor, flattener, recorder=None) -> dict:
                               "target", "action", "reward")}
     if recorder is not None:
         recorder.log_step(env, None, timestep)
+    step = 0
     while not timestep.last():
-        action = actor.select_action(flattener(timestep.observation))
+        if step % action_repeat == 0:
+            action = actor.select_action(flattener(timestep.observation))
         timestep = env.step(action)
+        step += 1
         position_error, attitude_error = probes.head_errors(env)
         series["time"].append(float(physics.data.time))
         series["position_error"].append(position_error)
@@ -81,7 +86,7 @@ def heldout_targets(domain: str, num_targets: Optional[int] = None):
 
 
 def evaluate_heldout(actor, flattener, domain: str, task: str, num_targets: Optional[int] = None,
-                     seed: int = 10_000, targets=None) -> dict:
+                     seed: int = 10_000, targets=None, action_repeat: int = 1) -> dict:
     """Deterministic policy, one episode per held-out target (a pool of that single target).
 
     Use a task with a fixed initial state (lesson2): every target then starts from the same pose.
@@ -98,7 +103,7 @@ def evaluate_heldout(actor, flattener, domain: str, task: str, num_targets: Opti
             env.task.target_pool = targets[i:i + 1]  # reuse the compiled model (building one takes ~0.3 s)
         else:
             env = make_environment(domain, task, seed, target_pool=targets[i:i + 1])
-        row = _episode_summary(rollout(env, actor, flattener))
+        row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat))
         if targets is not None:
             row["target"] = targets[i].tolist()
         episodes.append(row)
@@ -106,10 +111,10 @@ def evaluate_heldout(actor, flattener, domain: str, task: str, num_targets: Opti
 
 
 def evaluate_track(actor, flattener, domain: str = "robostrich", task: str = "track", seed: int = 20_000,
-                   recorder=None) -> dict:
+                   recorder=None, action_repeat: int = 1) -> dict:
     """The `track` task: targets in order (Fig. 7); one summary per target segment plus the series."""
     env = make_environment(domain, task, seed)
-    series = rollout(env, actor, flattener, recorder=recorder)
+    series = rollout(env, actor, flattener, recorder=recorder, action_repeat=action_repeat)
     segments = []
     targets = series["target"]
     bounds = [0] + [i for i in range(1, len(targets)) if targets[i] != targets[i - 1]] + [len(series["time"])]
@@ -123,17 +128,19 @@ def evaluate_track(actor, flattener, domain: str = "robostrich", task: str = "tr
 
 def evaluate_agent(actor, flattener, out_dir: str, label: str, domain: str, heldout_task: str,
                    track_task: Optional[str], num_targets: Optional[int] = None, env_steps: int = None,
-                   record: bool = True) -> dict:
+                   record: bool = True, action_repeat: int = 1) -> dict:
     """Held-out + track evaluation, JSON reports and (optionally) a Rerun recording of the track rollout."""
     os.makedirs(out_dir, exist_ok=True)
-    reports = {"heldout": evaluate_heldout(actor, flattener, domain, heldout_task, num_targets)}
+    reports = {"heldout": evaluate_heldout(actor, flattener, domain, heldout_task, num_targets,
+                                           action_repeat=action_repeat)}
     if track_task:
         recorder = None
         if record:
             from agents.recording import RolloutRecorder
             recorder = RolloutRecorder(os.path.join(out_dir, f"{label}_track.rrd"), name=f"{label} track")
         try:
-            reports["track"] = evaluate_track(actor, flattener, domain, track_task, recorder=recorder)
+            reports["track"] = evaluate_track(actor, flattener, domain, track_task, recorder=recorder,
+                                              action_repeat=action_repeat)
         finally:
             if recorder is not None:
                 recorder.close()
@@ -164,9 +171,12 @@ def load_run_from_checkpoint(path: str):
     from agents.curriculum import CurriculumRun, parse_plan
     from agents.sac.config import SACConfig
     fp = checkpoint.read_fingerprint(path)
-    run = CurriculumRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"],
-                        os.path.join(os.path.dirname(os.path.abspath(path)), ".evaluate"))
-    run.restore(path)
+    scratch = tempfile.mkdtemp(prefix="robostrich-evaluate-")  # the run's own files are left untouched
+    try:
+        run = CurriculumRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch)
+        run.restore(path)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
     return run
 
 
@@ -189,7 +199,8 @@ def main(argv=None):
     track_task = args.track_task if domain in ROBOSTRICH_DOMAINS else None
     reports = evaluate_agent(actor, run.loop.flattener, out, args.label, domain,
                              args.heldout_task or run.plan[-1].task, track_task or None, args.num_targets,
-                             env_steps=run.loop.env_steps, record=not args.no_rerun)
+                             env_steps=run.loop.env_steps, record=not args.no_rerun,
+                             action_repeat=run.config.action_repeat)
     if not args.no_figures and "track" in reports:
         from agents import figures
         figures.plot_track({args.label: reports["track"]}, os.path.join(out, f"{args.label}_track.png"))

@@ -1,8 +1,8 @@
 """EnvironmentLoop: acts, stores transitions, and calls the learner every few steps.
 
-Per environment step the Python work is: one jitted policy call, env.step,
-one flatten and one row insert. The learner is called once per
-`config.env_steps_per_call` steps with a whole stack of batches.
+Per agent step the Python work is: one jitted policy call, env.step (times
+the action repeat), one flatten and one row insert. The learner is called
+once per `config.env_steps_per_call` transitions with a whole stack of batches.
 """
 import time
 from typing import Callable, Optional
@@ -22,7 +22,8 @@ class EnvironmentLoop:
         self.actor, self.replay, self.learner, self.config = actor, replay, learner, config
         self.flattener = flattener
         self.label = label
-        self.env_steps = 0  # all environment steps in this run (across lessons)
+        self.env_steps = 0  # all environment (control) steps in this run, across lessons
+        self.transitions = 0  # agent steps = transitions added to the replay
         self.episodes = 0
         self.warmup_rng = np.random.default_rng(seed + 7919)  # uniform actions before min_replay
         self.latest_metrics = {}
@@ -46,27 +47,41 @@ class EnvironmentLoop:
             policy_action = self.actor.policy_action(flat_obs)
         return policy_action
 
-    def run(self, num_steps: int, on_episode: Optional[Callable] = None,
-            on_step: Optional[Callable] = None) -> None:
-        """Run exactly num_steps environment steps (episodes may straddle calls)."""
+    def run(self, num_steps: int, on_episode: Optional[Callable] = None) -> int:
+        """Run at least num_steps environment (control) steps; returns how many were run.
+
+        With `config.action_repeat` k > 1 the agent acts every k control steps
+        (one transition, rewards summed, discounts multiplied), so a call may
+        overshoot by up to k - 1 steps; episodes may straddle calls.
+        """
         env, replay, adapter, flatten = self.env, self.replay, self.actor.adapter, self.flattener
         cfg = self.config
-        for _ in range(num_steps):
+        repeat = cfg.action_repeat
+        start = self.env_steps
+        target = start + num_steps
+        while self.env_steps < target:
             if self.timestep is None or self.timestep.last():
                 self.timestep = env.reset()
                 self._obs = flatten(self.timestep.observation)
                 self.episode_return, self.episode_length = 0.0, 0
             obs = self._obs
             policy_action = self._act(obs)
-            timestep = env.step(adapter.to_env(policy_action))
+            env_action = adapter.to_env(policy_action)
+            timestep = env.step(env_action)
+            reward, discount, taken = float(timestep.reward), float(timestep.discount), 1
+            while taken < repeat and not timestep.last():
+                timestep = env.step(env_action)
+                reward += float(timestep.reward)  # as Acme's ActionRepeat: summed, undiscounted
+                discount *= float(timestep.discount)
+                taken += 1
             next_obs = flatten(timestep.observation)
-            reward = float(timestep.reward)
-            replay.add(obs, policy_action, reward, float(timestep.discount), next_obs)
+            replay.add(obs, policy_action, reward, discount, next_obs)
             self.timestep, self._obs = timestep, next_obs
             self.episode_return += reward
-            self.episode_length += 1
-            self.env_steps += 1
-            if self.env_steps % cfg.env_steps_per_call == 0 and len(replay) >= cfg.min_replay_size:
+            self.episode_length += taken
+            self.env_steps += taken
+            self.transitions += 1
+            if self.transitions % cfg.env_steps_per_call == 0 and len(replay) >= cfg.min_replay_size:
                 batches = replay.sample_stack(cfg.updates_per_call, cfg.batch_size)
                 self.latest_metrics = self.learner.step(batches)
                 self.actor.update(self.learner.policy_params)
@@ -81,18 +96,17 @@ class EnvironmentLoop:
                         "success": probes.is_success(position_error, attitude_error),
                         "time": time.time(),
                     })
-            if on_step is not None:
-                on_step(self)
+        return self.env_steps - start
 
     def metrics_as_floats(self) -> dict:
         return {k: float(v) for k, v in self.latest_metrics.items()}
 
     def state_dict(self) -> dict:
-        return {"env_steps": self.env_steps, "episodes": self.episodes,
+        return {"env_steps": self.env_steps, "transitions": self.transitions, "episodes": self.episodes,
                 "warmup_rng": self.warmup_rng.bit_generator.state,
                 "episode_return": self.episode_return, "episode_length": self.episode_length}
 
     def load_state_dict(self, d: dict):
-        self.env_steps, self.episodes = d["env_steps"], d["episodes"]
+        self.env_steps, self.transitions, self.episodes = d["env_steps"], d["transitions"], d["episodes"]
         self.warmup_rng.bit_generator.state = d["warmup_rng"]
         self.episode_return, self.episode_length = d["episode_return"], d["episode_length"]

@@ -80,6 +80,8 @@ def build_parser():
     p.add_argument("--eval-every", type=int, default=None, help="held-out evaluation period (default: steps/6)")
     p.add_argument("--num-eval-targets", type=int, default=20,
                    help="held-out targets in the periodic evaluations (the final one uses all)")
+    p.add_argument("--final-eval-targets", type=int, default=None,
+                   help="held-out targets in the final evaluation (default: all)")
     p.add_argument("--heldout-task", default=None,
                    help="task for held-out evaluation (default: lesson2 on robostrich, i.e. eq. 10 from the "
                         "fixed initial pose; else the final lesson)")
@@ -99,7 +101,8 @@ def build_parser():
     g.add_argument("--replay-size", type=int, default=1_000_000)
     g.add_argument("--updates-per-call", type=int, default=8)
     g.add_argument("--env-steps-per-call", type=int, default=16,
-                   help="update-to-data ratio = updates-per-call / env-steps-per-call")
+                   help="agent steps between learner calls; update-to-data ratio = updates-per-call / this")
+    g.add_argument("--action-repeat", type=int, default=1, help="control steps per agent decision")
     return p
 
 
@@ -108,7 +111,8 @@ def config_from_args(args) -> SACConfig:
                      tau=args.tau, init_temperature=args.init_temperature,
                      hidden_sizes=tuple(int(h) for h in args.hidden.split(",") if h),
                      min_replay_size=args.min_replay, max_replay_size=args.replay_size,
-                     updates_per_call=args.updates_per_call, env_steps_per_call=args.env_steps_per_call)
+                     updates_per_call=args.updates_per_call, env_steps_per_call=args.env_steps_per_call,
+                     action_repeat=args.action_repeat)
 
 
 def plan_from_args(args):
@@ -177,8 +181,8 @@ def main(argv=None):
             def on_eval(r):
                 actor = SACBuilder.make_eval_actor(r.loop)
                 report = evaluation.evaluate_heldout(actor, r.loop.flattener, domain, heldout_task,
-                                                     args.num_eval_targets)
-                record = {"env_steps": r.loop.env_steps, "lesson": r.lesson_index, "summary": report["summary"]}
+                                                     args.num_eval_targets, action_repeat=config.action_repeat)
+                record = {"env_steps": r.loop.env_steps, "lessons_completed": r.lesson_index, "summary": report["summary"]}
                 with open(r.evals_path, "a") as f:
                     f.write(json.dumps(record) + "\n")
 
@@ -194,9 +198,10 @@ def main(argv=None):
     for label, run in runs.items():
         actor = SACBuilder.make_eval_actor(run.loop)
         finals[label] = evaluation.evaluate_agent(actor, run.loop.flattener, out_eval, label, domain, heldout_task,
-                                                  track_task, None if domain in ROBOSTRICH_DOMAINS else args.num_eval_targets,
-                                                  env_steps=run.loop.env_steps,
-                                                  record=not args.no_rerun)
+                                                  track_task, args.final_eval_targets or
+                                                  (None if domain in ROBOSTRICH_DOMAINS else args.num_eval_targets),
+                                                  env_steps=run.loop.env_steps, record=not args.no_rerun,
+                                                  action_repeat=config.action_repeat)
     metrics = {label: read_jsonl(run.metrics_path) for label, run in runs.items()}
     evals = {label: read_jsonl(run.evals_path) for label, run in runs.items()}
     if not args.no_figures:

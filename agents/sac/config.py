@@ -21,16 +21,19 @@ class SACConfig:
     min_replay_size: int = 10_000
     max_replay_size: int = 1_000_000
     # The learner runs `updates_per_call` gradient steps (one lax.scan) every
-    # `env_steps_per_call` environment steps: update-to-data ratio = their quotient.
+    # `env_steps_per_call` agent steps (transitions): update-to-data ratio = their quotient.
     updates_per_call: int = 8
     env_steps_per_call: int = 8
+    # The agent acts every `action_repeat` control steps (0.008 s each); the tendon
+    # servos settle in ~1.5 s, so a decision per control step mostly adds noise.
+    action_repeat: int = 1
     reward_scale: float = 1.0
     log_std_min: float = -5.0
     log_std_max: float = 2.0
 
     def __post_init__(self):
-        if self.batch_size <= 0 or self.updates_per_call <= 0 or self.env_steps_per_call <= 0:
-            raise ValueError("batch_size, updates_per_call and env_steps_per_call must be positive")
+        if min(self.batch_size, self.updates_per_call, self.env_steps_per_call, self.action_repeat) <= 0:
+            raise ValueError("batch_size, updates_per_call, env_steps_per_call and action_repeat must be positive")
         if not 0.0 < self.tau <= 1.0:
             raise ValueError(f"tau must be in (0, 1], got {self.tau}")
         if self.min_replay_size > self.max_replay_size:
