@@ -51,7 +51,7 @@ def test_checkpoint_round_trips_bit_exactly_and_continues_identically(tmp_path):
 
 def test_killed_and_resumed_run_matches_an_uninterrupted_one(tmp_path):
     args = TINY_ARGS + ["--plan", "point_mass/easy:600,point_mass/hard:600", "--checkpoint-every", "400",
-                        "--seed", "3"]
+                        "--seed", "3", "--action-repeat", "2"]
     whole, killed = str(tmp_path / "whole"), str(tmp_path / "killed")
     training.main(args + ["--out", whole])
     with pytest.raises(TrainingInterrupted):
@@ -62,6 +62,7 @@ def test_killed_and_resumed_run_matches_an_uninterrupted_one(tmp_path):
     fp = checkpoint.read_fingerprint(os.path.join(whole, "curriculum", "checkpoint.pkl"))
     a, b = (checkpoint.load(os.path.join(d, "curriculum", "checkpoint.pkl"), fp) for d in (whole, killed))
     assert a["loop"]["env_steps"] == b["loop"]["env_steps"] == 1200
+    assert a["loop"]["transitions"] == b["loop"]["transitions"] == 600  # action repeat 2
     assert (a["lesson_index"], a["lesson_steps"]) == (b["lesson_index"], b["lesson_steps"]) == (2, 0)
     assert int(a["learner"].steps) == int(b["learner"].steps) > 0
     for x, y in zip(leaves(a["learner"]), leaves(b["learner"])):
@@ -118,3 +119,15 @@ def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
     fresh = CurriculumRun(plan[1:], TINY, seed=2, run_dir=str(tmp_path / "fresh"))
     assert any(not np.array_equal(x, y) for x, y in zip(seen["policy"], leaves(fresh.loop.learner.policy_params)))
     assert float(np.exp(run.loop.learner.state.log_alpha)) != TINY.init_temperature
+
+
+def test_action_repeat_holds_actions_and_sums_rewards(tmp_path):
+    config = SACConfig(**{**TINY.to_dict(), "action_repeat": 3, "hidden_sizes": (32, 32)})
+    run = CurriculumRun(parse_plan("point_mass/easy:1000"), config, seed=0, run_dir=str(tmp_path))
+    episodes = []
+    ran = run.loop.run(1000, on_episode=episodes.append)
+    assert ran == 1000 and run.loop.env_steps == 1000  # the episode end cuts the last repeat short
+    assert run.loop.transitions == len(run.loop.replay) == 334  # 333 full repeats + 1 step
+    assert episodes[0]["length"] == 1000
+    np.testing.assert_allclose(run.loop.replay.reward[:334].astype(np.float64).sum(), episodes[0]["return"],
+                               rtol=1e-5, atol=1e-4)
