@@ -26,7 +26,7 @@ from agents.curriculum import (ROBOSTRICH_DOMAINS, CurriculumRun, Lesson, Traini
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 
-DEFAULT_TOTAL_STEPS = 120_000
+DEFAULT_TOTAL_STEPS = 150_000  # per run: 50k control steps per lesson; ~40 min for both runs on 2 busy cores
 DEFAULT_LESSONS = ("lesson1", "lesson2", "lesson3")
 
 
@@ -74,7 +74,7 @@ def build_parser():
     p.add_argument("--plan", default=None,
                    help="explicit plan '[domain/]task:steps,...' (overrides --steps/--lessons)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--checkpoint-every", type=int, default=10_000)
+    p.add_argument("--checkpoint-every", type=int, default=25_000)
     p.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
                    help="also train plain SAC on the final lesson with the same total budget")
     p.add_argument("--eval-every", type=int, default=None, help="held-out evaluation period (default: steps/6)")
@@ -97,12 +97,12 @@ def build_parser():
     g.add_argument("--discount", type=float, default=0.99)
     g.add_argument("--tau", type=float, default=0.005)
     g.add_argument("--init-temperature", type=float, default=1.0)
-    g.add_argument("--min-replay", type=int, default=5_000)
+    g.add_argument("--min-replay", type=int, default=2_000, help="transitions before learning starts")
     g.add_argument("--replay-size", type=int, default=1_000_000)
     g.add_argument("--updates-per-call", type=int, default=8)
-    g.add_argument("--env-steps-per-call", type=int, default=16,
+    g.add_argument("--env-steps-per-call", type=int, default=8,
                    help="agent steps between learner calls; update-to-data ratio = updates-per-call / this")
-    g.add_argument("--action-repeat", type=int, default=1, help="control steps per agent decision")
+    g.add_argument("--action-repeat", type=int, default=5, help="control steps per agent decision")
     return p
 
 

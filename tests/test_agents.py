@@ -36,13 +36,13 @@ def test_critic_loss_falls_on_a_fixed_batch():
     learner = make_learner()
     # discount 0: the Bellman target is the reward itself, so the critics face a fixed regression.
     fixed = random_batch(1, 32)._replace(discount=np.zeros((1, 32), np.float32))
-    stack = Transitions(*(np.repeat(x, 25, axis=0) for x in fixed))
-    losses = [float(learner.step(stack)["critic_loss"]) for _ in range(8)]
+    stack = Transitions(*(np.repeat(x, 4, axis=0) for x in fixed))
+    losses = [float(learner.step(stack)["critic_loss"]) for _ in range(50)]
     assert all(np.isfinite(losses)) and losses[-1] < 0.4 * losses[0], losses
 
 
 def test_update_is_deterministic_for_a_seed_and_differs_across_seeds():
-    batches = random_batch(3, 32, seed=1)
+    batches = random_batch(4, 32, seed=1)
     a, b, c = make_learner(seed=3), make_learner(seed=3), make_learner(seed=4)
     ma, mb = a.step(batches), b.step(batches)
     c.step(batches)
@@ -50,7 +50,7 @@ def test_update_is_deterministic_for_a_seed_and_differs_across_seeds():
         np.testing.assert_array_equal(x, y)
     assert float(ma["critic_loss"]) == float(mb["critic_loss"])
     assert any(not np.array_equal(x, y) for x, y in zip(leaves(a.state.policy_params), leaves(c.state.policy_params)))
-    assert a.num_updates == 3
+    assert a.num_updates == 4
 
 
 def test_scan_of_k_updates_equals_k_single_updates():
@@ -67,7 +67,8 @@ def test_temperature_rises_when_entropy_is_below_target():
     config = SACConfig(**{**TINY.to_dict(), "target_entropy": 100.0, "hidden_sizes": (32, 32)})
     learner = make_learner(config=config)
     before = float(np.exp(learner.state.log_alpha))
-    learner.step(random_batch(20, 32))
+    for i in range(5):
+        learner.step(random_batch(4, 32, seed=i))
     assert float(np.exp(learner.state.log_alpha)) > before
 
 

@@ -32,7 +32,7 @@ def test_short_lesson1_training_improves_success_on_heldout_targets(tmp_path):
     run.run()
     trained_success, trained_error = position_report(run)
     assert trained_error < 0.5 * untrained_error, (untrained_error, trained_error)
-    assert trained_success >= untrained_success + 0.25, (untrained_success, trained_success)
+    assert trained_success >= untrained_success + 0.1, (untrained_success, trained_success)
 
 
 def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them(tmp_path):
