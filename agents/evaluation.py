@@ -76,6 +76,11 @@ def summarize(episodes) -> dict:
     }
 
 
+def default_heldout_task(domain: str, final_task: str) -> str:
+    """lesson2 on robostrich: reward eq. 10 from the fixed initial pose, so every target starts alike."""
+    return "lesson2" if domain in ROBOSTRICH_DOMAINS else final_task
+
+
 def heldout_targets(domain: str, num_targets: Optional[int] = None):
     """robostrich_suite.targets.heldout_targets() for the arm; None (seeded episodes) elsewhere."""
     if domain not in ROBOSTRICH_DOMAINS:
@@ -185,7 +190,8 @@ def main(argv=None):
     parser.add_argument("checkpoint", help="checkpoint.pkl written by robostrich-train")
     parser.add_argument("--out", default=None, help="report directory (default: next to the checkpoint)")
     parser.add_argument("--label", default="eval")
-    parser.add_argument("--heldout-task", default=None, help="task for held-out targets (default: last lesson's)")
+    parser.add_argument("--heldout-task", default=None,
+                        help="task for held-out targets (default: lesson2 on robostrich, else the last lesson)")
     parser.add_argument("--track-task", default="track", help="'' to skip")
     parser.add_argument("--num-targets", type=int, default=None)
     parser.add_argument("--no-rerun", action="store_true")
@@ -198,7 +204,8 @@ def main(argv=None):
     actor = SACBuilder.make_eval_actor(run.loop)
     track_task = args.track_task if domain in ROBOSTRICH_DOMAINS else None
     reports = evaluate_agent(actor, run.loop.flattener, out, args.label, domain,
-                             args.heldout_task or run.plan[-1].task, track_task or None, args.num_targets,
+                             args.heldout_task or default_heldout_task(domain, run.plan[-1].task),
+                             track_task or None, args.num_targets,
                              env_steps=run.loop.env_steps, record=not args.no_rerun,
                              action_repeat=run.config.action_repeat)
     if not args.no_figures and "track" in reports:

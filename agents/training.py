@@ -138,7 +138,7 @@ def main(argv=None):
     total = sum(l.steps for l in plan)
     final = plan[-1]
     domain = final.domain
-    heldout_task = args.heldout_task or ("lesson2" if domain in ROBOSTRICH_DOMAINS else final.task)
+    heldout_task = args.heldout_task or evaluation.default_heldout_task(domain, final.task)
     track_task = args.track_task if domain in ROBOSTRICH_DOMAINS else None
     run_plans = {"curriculum": plan}
     if args.baseline:

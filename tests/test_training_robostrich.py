@@ -38,7 +38,7 @@ def test_short_lesson1_training_improves_success_on_heldout_targets(tmp_path):
 def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them(tmp_path):
     from agents import training
     out = str(tmp_path / "run")
-    training.main(["--out", out, "--plan", "lesson1:200,lesson2:200,lesson3:200", "--hidden", "32,32",
+    training.main(["--out", out, "--plan", "lesson1:250,lesson2:250,lesson3:250", "--hidden", "32,32",
                    "--batch-size", "32", "--min-replay", "100", "--checkpoint-every", "300",
                    "--num-eval-targets", "2", "--final-eval-targets", "2", "--quiet"])
     for name in ("config.json", "summary.json", "training.rrd", "figures/learning_curves.png", "figures/track.png",
@@ -52,10 +52,10 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
     heldout = json.load(open(os.path.join(out, "evaluation", "curriculum_heldout.json")))
     assert heldout["summary"]["episodes"] == 2 and 0.0 <= heldout["summary"]["success_rate"] <= 1.0
     evals = [json.loads(l) for l in open(os.path.join(out, "curriculum", "evals.jsonl"))]
-    assert [e["env_steps"] for e in evals] == [100, 200, 300, 400, 500, 600]
+    assert [e["env_steps"] for e in evals] == [125, 250, 375, 500, 625, 750]
     # the baseline has the same total budget, on the final lesson alone
     baseline = json.load(open(os.path.join(out, "config.json")))["plans"]["baseline"]
-    assert baseline == "robostrich/lesson3:600"
+    assert baseline == "robostrich/lesson3:750"
     reports = evaluation.main([os.path.join(out, "curriculum", "checkpoint.pkl"), "--out", str(tmp_path / "ev"),
                                "--num-targets", "2", "--no-rerun"])
     assert reports["heldout"]["summary"] == heldout["summary"]  # deterministic policy, same targets
