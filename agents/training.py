@@ -26,7 +26,7 @@ from agents.curriculum import (ROBOSTRICH_DOMAINS, CurriculumRun, Lesson, Traini
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 
-DEFAULT_TOTAL_STEPS = 150_000  # per run: 50k control steps per lesson; ~40 min for both runs on 2 busy cores
+DEFAULT_TOTAL_STEPS = 240_000  # per run: 80k control steps per lesson; both runs ~45 min on 2 shared cores
 DEFAULT_LESSONS = ("lesson1", "lesson2", "lesson3")
 
 
