@@ -10,7 +10,9 @@ Learner: updates/s of the jitted `lax.scan` update (agents.sac.learning) against
 Environment loop: steps/s of agents.loop.EnvironmentLoop acting with the policy
 (no learning) against a plain loop (eager policy call, dict observations
 flattened with Python lists, transitions appended to a list) and against raw
-env.step with a fixed action.
+env.step with a fixed action; then with the training default's action repeat.
+Variants are measured in interleaved rounds, best round kept, so that other
+load on the machine biases the ratios as little as possible.
 """
 import argparse
 import os
@@ -91,13 +93,22 @@ def random_replay(n, obs_size, act_size, rng):
                        rng.normal(size=(n, obs_size)).astype(np.float32))
 
 
-def time_calls(fn, seconds):
-    fn()  # warm-up / compile
-    n, start = 0, time.perf_counter()
-    while time.perf_counter() - start < seconds:
-        fn()
-        n += 1
-    return n, time.perf_counter() - start
+def best_rates(variants: dict, seconds: float, rounds: int = 3) -> dict:
+    """Calls/s of each variant, measured in interleaved rounds and keeping each one's best round.
+
+    Interleaving and best-of make the ratios robust to other load on a shared machine.
+    """
+    for fn in variants.values():
+        fn()  # warm-up / compile
+    best = {name: 0.0 for name in variants}
+    for _ in range(rounds):
+        for name, fn in variants.items():
+            n, start = 0, time.perf_counter()
+            while time.perf_counter() - start < seconds / rounds:
+                fn()
+                n += 1
+            best[name] = max(best[name], n / (time.perf_counter() - start))
+    return best
 
 
 def main(argv=None):
@@ -107,7 +118,8 @@ def main(argv=None):
     p.add_argument("--hidden", default="256,256")
     p.add_argument("--batch", type=int, default=256)
     p.add_argument("--updates-per-call", type=int, default=8)
-    p.add_argument("--seconds", type=float, default=8.0, help="measuring time per variant")
+    p.add_argument("--seconds", type=float, default=4.0, help="measuring time per variant (split in rounds)")
+    p.add_argument("--action-repeat", type=int, default=5)
     args = p.parse_args(argv)
     env = make_environment(args.domain, args.task, 0)
     config = SACConfig(batch_size=args.batch, hidden_sizes=tuple(int(h) for h in args.hidden.split(",")),
@@ -130,21 +142,18 @@ def main(argv=None):
         m["critic_loss"].block_until_ready()
 
     make, initial = plain_sac(networks, config)
-    results = {}
+    variants = {"ours": ours}
     for name, jit in (("plain_jit_per_loss", True), ("plain_eager", False)):
         update, state = make(jit), initial(jax.random.PRNGKey(0))
-        key = [jax.random.PRNGKey(1)]
 
-        def plain():
+        def plain(update=update, state=state, key=[jax.random.PRNGKey(1)]):
             idx = rng.integers(0, 100_000, config.batch_size)
             batch = Transitions(*(jnp.asarray(x[idx]) for x in replay))
             key[0], sub = jax.random.split(key[0])
-            s = update(state, batch, sub)
-            jax.block_until_ready(s["target_q"])
-        calls, secs = time_calls(plain, args.seconds if jit else min(args.seconds, 4.0))
-        results[name] = calls / secs
-    calls, secs = time_calls(ours, args.seconds)
-    results["ours"] = calls * k / secs
+            jax.block_until_ready(update(state, batch, sub)["target_q"])
+        variants[name] = plain
+    results = best_rates(variants, args.seconds * 3)
+    results["ours"] *= k
     print("learner updates/s:")
     print(f"  ours (one jit, lax.scan x{k})       {results['ours']:9.1f}")
     print(f"  plain SAC, each loss jitted          {results['plain_jit_per_loss']:9.1f}   "
@@ -153,47 +162,53 @@ def main(argv=None):
           f"ratio ours/eager = {results['ours'] / results['plain_eager']:.1f}x")
 
     # --- environment loop ----------------------------------------------------------------
-    steps = 3000
+    chunk = 250
     loop.replay.size = 0  # act with the policy but never learn: measures the acting path only
     loop.config = SACConfig(**{**config.to_dict(), "min_replay_size": 0, "env_steps_per_call": 10 ** 9,
-                               "hidden_sizes": config.hidden_sizes})
-    loop.run(200)
-    start = time.perf_counter()
-    loop.run(steps)
-    ours_sps = steps / (time.perf_counter() - start)
-
+                               "hidden_sizes": config.hidden_sizes, "action_repeat": 1})
     policy_apply = networks.policy_apply  # eager haiku apply, the obvious first version
     params = learner.policy_params
-    transitions = []
-    ts = env.reset()
     adapter = loop.actor.adapter
-    key = jax.random.PRNGKey(0)
-    start = time.perf_counter()
-    for _ in range(steps // 3):
-        obs = jnp.asarray(np.concatenate([np.ravel(v) for v in ts.observation.values()])[None], jnp.float32)
-        key, sub = jax.random.split(key)
-        mean, log_std = policy_apply(params, obs)
-        a = np.asarray(jnp.tanh(mean + jnp.exp(log_std) * jax.random.normal(sub, mean.shape)))[0]
-        nts = env.step(adapter.to_env(a))
-        transitions.append((ts.observation, a, nts.reward, nts.discount, nts.observation))
-        ts = env.reset() if nts.last() else nts
-    plain_sps = (steps // 3) / (time.perf_counter() - start)
+    plain_env = make_environment(args.domain, args.task, 1)
+    plain_state = {"ts": plain_env.reset(), "key": jax.random.PRNGKey(0), "transitions": []}
 
+    def plain_loop():
+        for _ in range(chunk // 5):
+            ts = plain_state["ts"]
+            obs = jnp.asarray(np.concatenate([np.ravel(v) for v in ts.observation.values()])[None], jnp.float32)
+            plain_state["key"], sub = jax.random.split(plain_state["key"])
+            mean, log_std = policy_apply(params, obs)
+            a = np.asarray(jnp.tanh(mean + jnp.exp(log_std) * jax.random.normal(sub, mean.shape)))[0]
+            nts = plain_env.step(adapter.to_env(a))
+            plain_state["transitions"].append((ts.observation, a, nts.reward, nts.discount, nts.observation))
+            plain_state["ts"] = plain_env.reset() if nts.last() else nts
+
+    raw_env = make_environment(args.domain, args.task, 2)
+    raw_env.reset()
     action = adapter.to_env(np.zeros(act_size))
-    ts = env.reset()
-    start = time.perf_counter()
-    for _ in range(steps):
-        ts = env.step(action)
-        if ts.last():
-            env.reset()
-    raw_sps = steps / (time.perf_counter() - start)
+
+    def raw():
+        for _ in range(chunk):
+            if raw_env.step(action).last():
+                raw_env.reset()
+
+    repeat_loop = SACBuilder(SACConfig(**{**loop.config.to_dict(), "action_repeat": args.action_repeat,
+                                          "hidden_sizes": config.hidden_sizes})).make_components(
+        make_environment(args.domain, args.task, 3), seed=0)
+    repeat_loop.actor.update(params)
+    rates = best_rates({"ours": lambda: loop.run(chunk), "plain": plain_loop, "raw": raw,
+                        "ours_repeat": lambda: repeat_loop.run(chunk)}, args.seconds * 4)
+    ours_sps, raw_sps, repeat_sps = rates["ours"] * chunk, rates["raw"] * chunk, rates["ours_repeat"] * chunk
+    plain_sps = rates["plain"] * (chunk // 5)
     print("environment steps/s (acting, no learning):")
     print(f"  ours (EnvironmentLoop)               {ours_sps:9.1f}")
     print(f"  plain loop (eager policy, lists)     {plain_sps:9.1f}   ratio ours/plain = {ours_sps / plain_sps:.1f}x")
     print(f"  raw env.step, fixed action           {raw_sps:9.1f}   ours reaches {ours_sps / raw_sps:.0%} of raw")
+    print(f"  ours, action repeat {args.action_repeat}              {repeat_sps:9.1f}")
     ud = config.update_to_data_ratio
-    print(f"training throughput estimate at update-to-data {ud:g}: "
-          f"{1.0 / (1.0 / ours_sps + ud / results['ours']):.0f} env steps/s")
+    per_step = 1.0 / repeat_sps + ud / (args.action_repeat * results["ours"])
+    print(f"training throughput estimate (action repeat {args.action_repeat}, {ud:g} update per transition): "
+          f"{1.0 / per_step:.0f} env steps/s")
 
 
 if __name__ == "__main__":
