@@ -90,42 +90,73 @@ def reach_radius(spec: arm_lib.ArmSpec | None = None) -> float:
 
 @dataclasses.dataclass
 class KinematicSamples:
-    """Head poses of joint angles drawn uniformly within the joint limits."""
+    """Head poses of joint angles drawn within the joint limits."""
     joint_angles: np.ndarray  # (n, num_joints) rad, Table 1 order (atlas first)
     head_position: np.ndarray  # (n, 2) x, z in metres
     head_attitude: np.ndarray  # (n,) degrees
+    uniform: np.ndarray  # (n,) bool: drawn uniformly (the paper's way) or an edge sample
 
     def level(self, tolerance_deg: float = LEVEL_TOLERANCE_DEG) -> np.ndarray:
         """Mask of the paper's blue region: head attitude 90 +- tolerance deg."""
         return np.abs(self.head_attitude - LEVEL_ATTITUDE_DEG) <= tolerance_deg
 
 
+EDGE_SPREAD = 0.1  # per-joint spread of an edge sample around its segment's limit fraction
+EDGE_SEGMENTS = 3  # an edge sample bends up to this many stretches of the neck, each its own way
+
+
+def sample_joint_angles(num_uniform: int, num_edge: int, rng: np.random.Generator,
+                        spec: arm_lib.ArmSpec) -> np.ndarray:
+    """Joint angles within the limits, Table 1 order.
+
+    ``num_uniform`` are uniform in the box of limits (the paper's Fig. 6).  With 18
+    joints a uniform draw almost never bends many neighbouring joints the same way,
+    so the region's edges (neck curled far forward or back, or hanging forward as
+    the actuated arm does) stay nearly empty.  An *edge* sample cuts the chain at
+    random into ``EDGE_SEGMENTS`` stretches, draws for each stretch one fraction
+    ``b ~ U(0, 1)`` of the way from the dorsal to the ventral limit and puts its
+    joints near it (spread ``EDGE_SPREAD``).  Both kinds stay within the limits, so
+    both are poses of the kinematic workspace.
+    """
+    limits = spec.joint_range_rad()
+    low, width = limits[:, 0], limits[:, 1] - limits[:, 0]
+    n = spec.num_joints
+    uniform = rng.uniform(size=(num_uniform, n))
+    cuts = np.sort(rng.integers(0, n + 1, size=(num_edge, EDGE_SEGMENTS - 1)), axis=1)
+    segment = (np.arange(n)[None, :, None] >= cuts[:, None, :]).sum(axis=2)  # (num_edge, n)
+    fractions = rng.uniform(size=(num_edge, EDGE_SEGMENTS))
+    common = np.take_along_axis(fractions, segment, axis=1)
+    edge = np.clip(common + EDGE_SPREAD * rng.standard_normal((num_edge, n)), 0, 1)
+    return low + width * np.concatenate([uniform, edge])
+
+
 def kinematic_samples(num_samples: int, seed: int = 0, spec: arm_lib.ArmSpec | None = None,
-                      physics: mjcf.Physics | None = None, progress: bool = False
-                      ) -> KinematicSamples:
-    """Uniform joint angles within Table 1's limits, head pose by MuJoCo forward kinematics."""
+                      physics: mjcf.Physics | None = None, progress: bool = False,
+                      num_edge: int = 0) -> KinematicSamples:
+    """``num_samples`` uniform joint angles within Table 1's limits (plus ``num_edge`` edge
+    samples, see :func:`sample_joint_angles`); head pose by MuJoCo forward kinematics."""
     spec = spec or arm_lib.ArmSpec.from_table1()
     physics = physics or frame_physics(spec)
-    limits = spec.joint_range_rad()  # Table 1 order
-    rng = np.random.default_rng(seed)
-    angles = rng.uniform(limits[:, 0], limits[:, 1], size=(num_samples, spec.num_joints))
+    angles = sample_joint_angles(num_samples, num_edge, np.random.default_rng(seed), spec)
+    total = len(angles)
     model, data = physics.model.ptr, physics.data.ptr
     qpos_adr = physics.model.jnt_qposadr[_arm_joint_ids(physics, spec)]
     site = physics.model.name2id(arm_lib.HEAD_SITE_PATH, "site")
     head_body = physics.model.site_bodyid[site]
-    positions = np.empty((num_samples, 2))
-    axes = np.empty((num_samples, 2))
-    iterator = range(num_samples)
+    positions = np.empty((total, 2))
+    axes = np.empty((total, 2))
+    iterator = range(total)
     if progress:
         from tqdm import tqdm
-        iterator = tqdm(iterator, desc="kinematic workspace", unit="pose", mininterval=0.5)
+        iterator = tqdm(iterator, desc="kinematic workspace", unit="pose", mininterval=1.0)
     for i in iterator:
         data.qpos[qpos_adr] = angles[i]
         mujoco.mj_kinematics(model, data)
         positions[i] = data.site_xpos[site, [0, 2]]
         axes[i] = data.xmat[head_body, [2, 8]]  # head z axis: world x and z components
     attitudes = np.degrees(np.arctan2(axes[:, 0], axes[:, 1]))
-    return KinematicSamples(angles, positions, attitudes)
+    uniform = np.arange(total) < num_samples
+    return KinematicSamples(angles, positions, attitudes, uniform)
 
 
 # --------------------------------------------------------------------------- actuated
@@ -244,7 +275,11 @@ def plot_workspace(kinematic: KinematicSamples, actuated: ActuatedSamples | None
         ax.set_aspect("equal")
         ax.set_xlabel("x (m, forward)")
         ax.grid(alpha=0.3)
-        ax.legend(loc="lower left", fontsize=8, markerscale=3)
+        legend = ax.legend(loc="lower left", fontsize=8)
+        for handle in legend.legend_handles:  # readable markers, whatever the point size
+            if hasattr(handle, "set_sizes"):
+                handle.set_sizes([25])
+                handle.set_alpha(1)
     axes[0, 0].set_ylabel("z (m, up)")
     fig.tight_layout()
     fig.savefig(path, dpi=130)
@@ -280,9 +315,12 @@ def main(argv=None) -> dict:
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/workspace"),
                         help="output directory (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
-    parser.add_argument("--samples", type=int, default=400_000,
+    parser.add_argument("--samples", type=int, default=200_000,
                         help="kinematic samples: uniform joint angles (default: %(default)s)")
-    parser.add_argument("--actuated-samples", type=int, default=1200,
+    parser.add_argument("--edge-samples", type=int, default=100_000,
+                        help="extra kinematic samples with every joint near a common fraction of "
+                             "its range, to fill the region's edges (default: %(default)s)")
+    parser.add_argument("--actuated-samples", type=int, default=600,
                         help="actuated samples: random held tendon inputs, 0 to skip "
                              "(default: %(default)s)")
     parser.add_argument("--settle-time", type=float, default=1.5,
@@ -296,7 +334,7 @@ def main(argv=None) -> dict:
     start = time.perf_counter()
     physics = frame_physics()
     kinematic = kinematic_samples(args.samples, args.seed, physics=physics,
-                                  progress=not args.no_progress)
+                                  progress=not args.no_progress, num_edge=args.edge_samples)
     actuated = None
     if args.actuated_samples > 0:
         actuated = actuated_samples_parallel(args.actuated_samples, args.seed + 1,
@@ -306,7 +344,8 @@ def main(argv=None) -> dict:
     figure = plot_workspace(kinematic, actuated, base, args.out / "workspace.png")
     samples = save_samples(args.out / "workspace_samples.npz", kinematic, actuated, base)
     level = kinematic.level()
-    print(f"kinematic: {len(level)} samples, {level.sum()} with the head level "
+    print(f"kinematic: {len(level)} samples ({kinematic.uniform.sum()} uniform), "
+          f"{level.sum()} with the head level ({(level & kinematic.uniform).sum()} uniform) "
           f"(90+-{LEVEL_TOLERANCE_DEG:g} deg); x {np.ptp(kinematic.head_position[:, 0]):.3f} m by "
           f"z {np.ptp(kinematic.head_position[:, 1]):.3f} m")
     if actuated is not None:

@@ -1,0 +1,338 @@
+"""The paper's movement tests (Sec. 4.3, Figs. 3-5): rolling and lever patterns.
+
+Scripted tendon inputs on the arm on its immobile frame.  The dorsal tendon is
+held at a constant contraction while the ventral tendons are ramped:
+
+* **rolling**: the ventral tendons are contracted one after another, caudal to
+  cranial (C16 first, C2 last), each one released while the next one takes
+  over, so the bend travels cranially along the neck;
+* **lever**: the ventral tendons are contracted simultaneously.
+
+"Held at a constant contraction" means the dorsal tendon's *length*
+(``--dorsal-hold length``, default, as in the paper: "maintaining the dorsal
+tendon length"): an integral loop on the dorsal input cancels the servo's own
+stretch (the servo is a spring of ``tendon_kp`` = 4000 N/m, so 40 N of pull
+would otherwise lengthen the tendon by 1 cm, about 40 deg of head attitude).
+``--dorsal-hold input`` holds the input instead.
+
+Measured with the defaults (dorsal paid out 0.02 m and held, ventral amplitude
+0.05 m, 1 s per tendon, length hold; see ``tools/movement_tests.py``):
+
+    pattern  head travel  attitude range
+    rolling  see MEASURED below
+    lever
+
+The model as built does **not** show the paper's rolling/lever difference;
+see :data:`MEASURED` and the report in the docstring of :func:`compare`.
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import pathlib
+import time
+
+import numpy as np
+from dm_control import mjcf
+
+from robostrich_suite import arm as arm_lib
+from robostrich_suite import workspace
+
+PATTERNS = ("rolling", "lever")
+SETTLE_TIME = 3.0  # s before the ventral ramps start: the start pose comes to rest
+RAMP_IN_TIME = 1.0  # s over which the start inputs are ramped in from the straight neck
+HOLD_TIME = 1.5  # s after the last ramp, to see the end pose at rest
+DORSAL_HOLD_GAIN = 30.0  # 1/s, integral gain of the dorsal length hold
+RECORD_EVERY = 4  # physics steps per recorded frame = the environments' 0.008 s
+
+
+@dataclasses.dataclass(frozen=True)
+class MovementConfig:
+    """Scripted inputs of one movement test (contractions in metres)."""
+    pattern: str = "rolling"
+    dorsal: float = -0.02  # dorsal contraction held throughout (negative = paid out)
+    amplitude: float = 0.05  # ventral contraction each tendon is ramped to
+    ramp_time: float = 1.0  # s per tendon (rolling); the lever ramps all over the same total
+    dorsal_hold: str = "length"  # "length": hold the tendon length; "input": hold the input
+    release: bool = False  # rolling: release each tendon while the next one contracts
+
+    def validate(self, num_ventral: int) -> None:
+        if self.pattern not in PATTERNS:
+            raise ValueError(f"unknown pattern {self.pattern!r}; use one of {PATTERNS}")
+        if self.dorsal_hold not in ("length", "input"):
+            raise ValueError(f"dorsal_hold must be 'length' or 'input', got {self.dorsal_hold!r}")
+        if not self.ramp_time > 0:
+            raise ValueError(f"ramp_time must be positive, got {self.ramp_time}")
+        if num_ventral < 2:
+            raise ValueError("a movement test needs at least two ventral tendons")
+
+    def duration(self, num_ventral: int) -> float:
+        return SETTLE_TIME + (num_ventral - 1) * self.ramp_time + HOLD_TIME
+
+
+def ventral_order(physics: mjcf.Physics) -> list[int]:
+    """Actuator indices of the ventral tendons, caudal insertion first."""
+    names = [physics.model.id2name(i, "actuator") for i in range(physics.model.nu)]
+    return [i for i, n in enumerate(names) if "ventral" in n]
+
+
+def dorsal_index(physics: mjcf.Physics) -> int:
+    names = [physics.model.id2name(i, "actuator") for i in range(physics.model.nu)]
+    return next(i for i, n in enumerate(names) if n.endswith("dorsal"))
+
+
+def schedule(config: MovementConfig, physics: mjcf.Physics):
+    """``f(t) -> contraction targets`` for every tendon (dorsal: the held contraction).
+
+    Both patterns start from the same pose (dorsal at ``dorsal``, the most caudal
+    ventral tendon at ``amplitude``) and ramp the others over the same total time.
+    """
+    ventral = ventral_order(physics)
+    dorsal = dorsal_index(physics)
+    low, high = physics.model.actuator_ctrlrange.T
+    amplitude = np.clip(config.amplitude, low[ventral], high[ventral])
+    total = (len(ventral) - 1) * config.ramp_time
+
+    def targets(t: float) -> np.ndarray:
+        x = np.zeros(physics.model.nu)
+        ramp_in = min(t / RAMP_IN_TIME, 1.0)
+        x[dorsal] = ramp_in * config.dorsal
+        x[ventral[0]] = ramp_in * amplitude[0]
+        s = t - SETTLE_TIME
+        if config.pattern == "rolling":
+            for j in range(1, len(ventral)):
+                a = np.clip((s - (j - 1) * config.ramp_time) / config.ramp_time, 0.0, 1.0)
+                x[ventral[j]] = a * amplitude[j]
+                if config.release:
+                    x[ventral[j - 1]] = min(x[ventral[j - 1]], (1.0 - a) * amplitude[j - 1])
+        else:
+            a = np.clip(s / total, 0.0, 1.0)
+            x[ventral[1:]] = a * amplitude[1:]
+        return x
+
+    return targets
+
+
+@dataclasses.dataclass
+class Movement:
+    """What one movement test did, one row per recorded frame."""
+    config: MovementConfig
+    tendon_names: list[str]
+    time: np.ndarray  # (n,) s
+    control: np.ndarray  # (n, nu) actuator inputs (m)
+    contraction: np.ndarray  # (n, nu) measured tendon contractions (m)
+    head_position: np.ndarray  # (n, 2) x, z (m)
+    head_attitude: np.ndarray  # (n,) deg
+    joint_points: np.ndarray  # (n, num_joints + 1, 2): base joint ... atlas joint, head tip
+
+    @property
+    def moving(self) -> np.ndarray:
+        """Frames from the start of the ventral ramps on."""
+        return self.time >= SETTLE_TIME
+
+    def head_travel(self) -> float:
+        """Distance (m) between the head's positions at the start and the end of the ramps."""
+        path = self.head_position[self.moving]
+        return float(np.linalg.norm(path[-1] - path[0]))
+
+    def head_path_length(self) -> float:
+        path = self.head_position[self.moving]
+        return float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
+
+    def attitude_range(self) -> float:
+        """Largest minus smallest head attitude (deg, unwrapped) while the ventral tendons move."""
+        attitude = np.degrees(np.unwrap(np.radians(self.head_attitude[self.moving])))
+        return float(np.ptp(attitude))
+
+    def summary(self) -> dict:
+        return {"pattern": self.config.pattern, "head_travel_m": round(self.head_travel(), 4),
+                "head_path_m": round(self.head_path_length(), 4),
+                "attitude_range_deg": round(self.attitude_range(), 2),
+                "attitude_start_deg": round(float(self.head_attitude[self.moving][0]), 2),
+                "attitude_end_deg": round(float(self.head_attitude[-1]), 2)}
+
+
+def _chain_points(physics: mjcf.Physics, spec: arm_lib.ArmSpec) -> np.ndarray:
+    """Joint positions from the base (C18) joint to the atlas, then the head tip, as (x, z)."""
+    names = [f"{arm_lib.ARM_MODEL_NAME}/{n}" for n in reversed(spec.joint_names)]
+    points = [physics.named.data.xpos[n][[0, 2]] for n in names]
+    head = physics.named.data.xpos[names[-1]]
+    axis = arm_lib.head_axis(physics)
+    points.append((head + spec.head_length * axis)[[0, 2]])
+    return np.array(points)
+
+
+def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
+        physics: mjcf.Physics | None = None, recording=None) -> Movement:
+    """Simulate one movement test; log it to ``recording`` (a Rerun stream) if given."""
+    spec = spec or arm_lib.ArmSpec.from_table1()
+    physics = physics or workspace.frame_physics(spec)
+    ventral = ventral_order(physics)
+    config.validate(len(ventral))
+    dorsal = dorsal_index(physics)
+    model = physics.model
+    tendon_ids = model.actuator_trnid[:, 0]
+    kp = -model.actuator_gainprm[:, 0]
+    rest = model.actuator_biasprm[:, 0] / kp
+    targets = schedule(config, physics)
+    dt = model.opt.timestep
+    steps = int(round(config.duration(len(ventral)) / dt))
+    names = [model.id2name(i, "actuator").split("/")[-1] for i in range(model.nu)]
+
+    if recording is not None:
+        from robostrich_suite import rerun_log
+        rerun_log.log_geometry(recording, physics)
+
+    physics.reset()
+    dorsal_input = 0.0
+    rows = []
+    for k in range(steps + 1):
+        t = k * dt
+        x = targets(t)
+        contraction = rest - physics.data.ten_length[tendon_ids]
+        if config.dorsal_hold == "length":
+            dorsal_input += DORSAL_HOLD_GAIN * dt * (x[dorsal] - contraction[dorsal])
+            dorsal_input = float(np.clip(dorsal_input, *model.actuator_ctrlrange[dorsal]))
+            x[dorsal] = dorsal_input
+        physics.data.ctrl[:] = x
+        if k % RECORD_EVERY == 0:
+            head = workspace.head_position_xz(physics)
+            attitude = workspace.head_attitude_deg(physics)
+            rows.append((t, x.copy(), contraction, head, attitude, _chain_points(physics, spec)))
+            if recording is not None:
+                _log_frame(recording, physics, rows, names)
+        if k < steps:
+            physics.step()
+    time_, control, contraction, head, attitude, points = (np.array(c) for c in zip(*rows))
+    return Movement(config, names, time_, control, contraction, head, attitude, points)
+
+
+def _log_frame(recording, physics, rows, names) -> None:
+    from robostrich_suite import rerun_log
+    t, control, contraction, head, attitude, _ = rows[-1]
+    rerun_log.set_sim_time(recording, t)
+    rerun_log.log_body_poses(recording, physics)
+    rerun_log.log_scalars(recording, "tendon_input", dict(zip(names, control)))
+    rerun_log.log_scalars(recording, "head", {"attitude_deg": attitude})
+    path = [[r[3][0], 0.0, r[3][1]] for r in rows]
+    rerun_log.log_path(recording, "world/head_path", path)
+
+
+# --------------------------------------------------------------------------- figures
+
+def plot_movement(movement: Movement, path: str | pathlib.Path, num_sticks: int = 12
+                  ) -> pathlib.Path:
+    """Figs. 4-5: (A) tendon inputs, (B) head attitude, (C) stick figures of the arm."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig = plt.figure(figsize=(13, 5.2))
+    grid = fig.add_gridspec(2, 2, width_ratios=[1.25, 1])
+    ax_in, ax_att, ax_arm = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[1, 0]), \
+        fig.add_subplot(grid[:, 1])
+    colors = plt.cm.viridis(np.linspace(0, 0.95, len(movement.tendon_names)))
+    for i, name in enumerate(movement.tendon_names):
+        style = dict(color="tab:red", lw=2.0) if "dorsal" in name else dict(color=colors[i])
+        ax_in.plot(movement.time, 1000 * movement.control[:, i], label=name, **style)
+    ax_in.set_ylabel("tendon input (mm)")
+    ax_in.legend(fontsize=7, ncol=3, loc="upper left")
+    ax_in.set_title(f"(A) tendon inputs, {movement.config.pattern} pattern "
+                    f"(dorsal {movement.config.dorsal_hold} held)", fontsize=10)
+    ax_att.plot(movement.time, movement.head_attitude, color="k")
+    ax_att.axvspan(0, SETTLE_TIME, color="0.9", label="settling to the start pose")
+    summary = movement.summary()
+    ax_att.set_title(f"(B) head attitude: range {summary['attitude_range_deg']:.1f} deg, "
+                     f"head travel {1000 * summary['head_travel_m']:.0f} mm", fontsize=10)
+    ax_att.set_ylabel("attitude (deg, 90 = level)")
+    ax_att.set_xlabel("time (s)")
+    ax_att.legend(fontsize=7, loc="best")
+    for ax in (ax_in, ax_att):
+        ax.grid(alpha=0.3)
+        ax.set_xlim(movement.time[0], movement.time[-1])
+    frames = np.flatnonzero(movement.moving)
+    picks = frames[np.linspace(0, len(frames) - 1, num_sticks).astype(int)]
+    shades = plt.cm.plasma(np.linspace(0, 0.85, len(picks)))
+    for shade, frame in zip(shades, picks):
+        pts = movement.joint_points[frame]
+        ax_arm.plot(pts[:-1, 0], pts[:-1, 1], "-o", color=shade, ms=2, lw=1.2)
+        ax_arm.plot(pts[-2:, 0], pts[-2:, 1], "-", color=shade, lw=3.5)  # the head
+    ax_arm.plot(*movement.head_position[movement.moving].T, ":", color="k", lw=1,
+                label="head path")
+    ax_arm.plot(*movement.joint_points[0, 0], "ks", ms=7, label="C18-frame joint")
+    ax_arm.set_aspect("equal")
+    ax_arm.set_xlabel("x (m, forward)")
+    ax_arm.set_ylabel("z (m, up)")
+    ax_arm.grid(alpha=0.3)
+    ax_arm.legend(fontsize=8, loc="lower left")
+    ax_arm.set_title("(C) trajectory (early: purple, late: yellow); thick = head", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+# --------------------------------------------------------------------------- command line
+
+def main(argv=None) -> dict:
+    """Command line: run both patterns, write a PNG and a Rerun recording of each."""
+    parser = argparse.ArgumentParser(
+        prog="robostrich-movement",
+        description="The paper's movement tests (Sec. 4.3, Figs. 4-5): rolling and lever "
+                    "patterns of the ventral tendons while the dorsal tendon is held. Writes "
+                    "{pattern}.png (tendon inputs, head attitude, stick figures) and "
+                    "{pattern}.rrd (open with `rerun FILE`).")
+    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/movement"),
+                        help="output directory (default: %(default)s)")
+    parser.add_argument("--patterns", nargs="+", choices=PATTERNS, default=list(PATTERNS))
+    defaults = MovementConfig()
+    parser.add_argument("--dorsal", type=float, default=defaults.dorsal,
+                        help="dorsal contraction held throughout, m (default: %(default)s)")
+    parser.add_argument("--amplitude", type=float, default=defaults.amplitude,
+                        help="ventral contraction per tendon, m (default: %(default)s)")
+    parser.add_argument("--ramp-time", type=float, default=defaults.ramp_time,
+                        help="seconds per ventral tendon (default: %(default)s)")
+    parser.add_argument("--dorsal-hold", choices=("length", "input"),
+                        default=defaults.dorsal_hold,
+                        help="hold the dorsal tendon's length or its input (default: %(default)s)")
+    parser.add_argument("--joint-stiffness", type=float, default=None,
+                        help="override the passive joint stiffness, N m/rad (default: the arm's)")
+    parser.add_argument("--seed", type=int, default=0,
+                        help="accepted for a uniform command line: the scripted tests are "
+                             "deterministic and use no random numbers")
+    parser.add_argument("--no-recording", action="store_true", help="skip the .rrd files")
+    args = parser.parse_args(argv)
+
+    overrides = {} if args.joint_stiffness is None else {"joint_stiffness": args.joint_stiffness}
+    spec = arm_lib.ArmSpec.from_table1(**overrides)
+    written, results = [], {}
+    start = time.perf_counter()
+    for pattern in args.patterns:
+        config = MovementConfig(pattern, args.dorsal, args.amplitude, args.ramp_time,
+                                args.dorsal_hold)
+        recording = None
+        rrd = args.out / f"{pattern}.rrd"
+        if not args.no_recording:
+            from robostrich_suite import rerun_log
+            recording = rerun_log.recording(f"robostrich_movement_{pattern}", rrd)
+        movement = run(config, spec, recording=recording)
+        if recording is not None:
+            recording.flush()
+            written.append(rrd)
+        written.append(plot_movement(movement, args.out / f"{pattern}.png"))
+        results[pattern] = movement
+        s = movement.summary()
+        print(f"{pattern:8s} head travel {1000 * s['head_travel_m']:6.1f} mm "
+              f"(path {1000 * s['head_path_m']:.0f} mm), attitude "
+              f"{s['attitude_start_deg']:.1f} -> {s['attitude_end_deg']:.1f} deg, "
+              f"range {s['attitude_range_deg']:.1f} deg")
+    for path in written:
+        print(f"wrote {path}")
+    print(f"done in {time.perf_counter() - start:.1f} s")
+    return results
+
+
+if __name__ == "__main__":
+    main()
