@@ -127,7 +127,8 @@ def sample_joint_angles(num_uniform: int, num_edge: int, rng: np.random.Generato
     fractions = rng.uniform(size=(num_edge, EDGE_SEGMENTS))
     common = np.take_along_axis(fractions, segment, axis=1)
     edge = np.clip(common + EDGE_SPREAD * rng.standard_normal((num_edge, n)), 0, 1)
-    return low + width * np.concatenate([uniform, edge])
+    angles = low + width * np.concatenate([uniform, edge])
+    return np.clip(angles, limits[:, 0], limits[:, 1])  # no rounding past a limit
 
 
 def kinematic_samples(num_samples: int, seed: int = 0, spec: arm_lib.ArmSpec | None = None,
