@@ -91,7 +91,7 @@ def _rerun_cli():
 
 
 def test_command_line_writes_figures_and_valid_recordings(tmp_path):
-    results = movement.main(["--out", str(tmp_path), "--ramp-time", "0.25"])
+    results = movement.main(["--out", str(tmp_path), "--ramp-time", "0.25", "--no-progress"])
     assert set(results) == set(movement.PATTERNS)
     cli = _rerun_cli()
     assert cli, "the rerun command of rerun-sdk is not installed"
