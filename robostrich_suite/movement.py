@@ -66,6 +66,8 @@ class MovementConfig:
     ramp_time: float = 1.0  # s per tendon (rolling); the lever ramps all over the same total
     dorsal_hold: str = "length"  # "length": hold the tendon length; "input": hold the input
     release: bool = False  # rolling: release each tendon while the next one contracts
+    input_noise: float = 0.0  # m, std of Gaussian noise on the ventral inputs per control step
+    seed: int = 0  # of the input noise
 
     def validate(self, num_ventral: int) -> None:
         if self.pattern not in PATTERNS:
@@ -196,6 +198,8 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
         rerun_log.log_geometry(recording, physics)
 
     physics.reset()
+    rng = np.random.default_rng(config.seed)
+    noise = np.zeros(model.nu)
     dorsal_input = 0.0
     rows = []
     iterator = range(steps + 1)
@@ -205,6 +209,10 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
     for k in iterator:
         t = k * dt
         x = targets(t)
+        if config.input_noise > 0:
+            if k % RECORD_EVERY == 0:  # a new draw each control step (0.008 s)
+                noise[ventral] = config.input_noise * rng.standard_normal(len(ventral))
+            x = np.clip(x + noise, *model.actuator_ctrlrange.T)
         contraction = rest - physics.data.ten_length[tendon_ids]
         if config.dorsal_hold == "length":
             dorsal_input += DORSAL_HOLD_GAIN * dt * (x[dorsal] - contraction[dorsal])
@@ -232,6 +240,74 @@ def _log_frame(recording, physics, rows, names) -> None:
     rerun_log.log_scalars(recording, "head", {"attitude_deg": attitude})
     path = [[r[3][0], 0.0, r[3][1]] for r in rows]
     rerun_log.log_path(recording, "world/head_path", path)
+
+
+# --------------------------------------------------------------------------- static poses
+
+@dataclasses.dataclass
+class PoseFamily:
+    """Settled poses for random ventral inputs at one held dorsal length."""
+    dorsal: float
+    ventral_inputs: np.ndarray  # (n, num_ventral) m
+    head_position: np.ndarray  # (n, 2) m
+    head_attitude: np.ndarray  # (n,) deg
+    settled: np.ndarray  # (n,) bool
+
+    def attitude_spread(self, radius: float = 0.015) -> tuple[float, float]:
+        """Median attitude difference (deg) of settled pose pairs whose heads are closer
+        than ``radius`` m, and of pairs farther than 0.1 m apart.  A small first number
+        means the attitude is a function of the head position: no ventral sequence can
+        move the head along one path with two different attitude histories."""
+        position = self.head_position[self.settled]
+        attitude = self.head_attitude[self.settled]
+        distance = np.linalg.norm(position[:, None] - position[None], axis=2)
+        difference = np.abs(attitude[:, None] - attitude[None])
+        near = (distance < radius) & (distance > 0)
+        far = distance > 0.1
+        median = lambda mask: float(np.median(difference[mask])) if mask.any() else float("nan")
+        return median(near), median(far)
+
+
+def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int = 0,
+                spec: arm_lib.ArmSpec | None = None, settle_time: float = 3.0,
+                progress: bool = False) -> PoseFamily:
+    """Hold the dorsal length at ``dorsal`` and random ventral inputs; record where the head
+    comes to rest.  Inputs are drawn as ``u**2`` times each tendon's range (more small
+    contractions, where the head moves most), a third of them with four tendons slack."""
+    spec = spec or arm_lib.ArmSpec.from_table1()
+    physics = workspace.frame_physics(spec)
+    model = physics.model
+    ventral, dorsal_id = ventral_order(physics), dorsal_index(physics)
+    tendon_ids = model.actuator_trnid[:, 0]
+    rest = model.actuator_biasprm[:, 0] / -model.actuator_gainprm[:, 0]
+    high = model.actuator_ctrlrange[ventral, 1]
+    rng = np.random.default_rng(seed)
+    inputs = rng.uniform(size=(num_poses, len(ventral))) ** 2 * high
+    for i in range(0, num_poses, 3):
+        inputs[i, rng.choice(len(ventral), 4, replace=False)] = 0.0
+    dt = model.opt.timestep
+    positions, attitudes = np.zeros((num_poses, 2)), np.zeros(num_poses)
+    settled = np.zeros(num_poses, bool)
+    iterator = range(num_poses)
+    if progress:
+        from tqdm import tqdm
+        iterator = tqdm(iterator, desc="static poses", unit="pose")
+    for i in iterator:
+        physics.reset()
+        dorsal_input = 0.0
+        for k in range(int(round(settle_time / dt))):
+            ramp = min(k * dt / RAMP_IN_TIME, 1.0)
+            contraction = rest[dorsal_id] - physics.data.ten_length[tendon_ids[dorsal_id]]
+            dorsal_input = float(np.clip(dorsal_input + DORSAL_HOLD_GAIN * dt
+                                         * (ramp * dorsal - contraction),
+                                         *model.actuator_ctrlrange[dorsal_id]))
+            physics.data.ctrl[dorsal_id] = dorsal_input
+            physics.data.ctrl[ventral] = ramp * inputs[i]
+            physics.step()
+        settled[i] = np.abs(physics.data.qvel).max() < 0.05
+        positions[i] = workspace.head_position_xz(physics)
+        attitudes[i] = workspace.head_attitude_deg(physics)
+    return PoseFamily(dorsal, inputs, positions, attitudes, settled)
 
 
 # --------------------------------------------------------------------------- figures
@@ -319,9 +395,16 @@ def main(argv=None) -> dict:
                         help="hold the dorsal tendon's length or its input (default: %(default)s)")
     parser.add_argument("--joint-stiffness", type=float, default=None,
                         help="override the passive joint stiffness, N m/rad (default: the arm's)")
+    parser.add_argument("--input-noise", type=float, default=0.0,
+                        help="std (m) of Gaussian noise added to the ventral inputs every "
+                             "control step, to see how robust a pattern is (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0,
-                        help="accepted for a uniform command line: the scripted tests are "
-                             "deterministic and use no random numbers")
+                        help="seed of the input noise; without noise the tests are "
+                             "deterministic (default: %(default)s)")
+    parser.add_argument("--pose-family", type=int, default=0, metavar="N",
+                        help="also settle N random ventral inputs at the held dorsal length and "
+                             "print how tightly the attitude follows the head position "
+                             "(about 0.1 s each; default: %(default)s)")
     parser.add_argument("--no-recording", action="store_true", help="skip the .rrd files")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     args = parser.parse_args(argv)
@@ -332,7 +415,7 @@ def main(argv=None) -> dict:
     start = time.perf_counter()
     for pattern in args.patterns:
         config = MovementConfig(pattern, args.dorsal, args.amplitude, args.ramp_time,
-                                args.dorsal_hold)
+                                args.dorsal_hold, input_noise=args.input_noise, seed=args.seed)
         recording = None
         rrd = args.out / f"{pattern}.rrd"
         if not args.no_recording:
@@ -349,6 +432,13 @@ def main(argv=None) -> dict:
               f"(path {1000 * s['head_path_m']:.0f} mm), attitude "
               f"{s['attitude_start_deg']:.1f} -> {s['attitude_end_deg']:.1f} deg, "
               f"range {s['attitude_range_deg']:.1f} deg")
+    if args.pose_family > 0:
+        family = pose_family(args.pose_family, args.dorsal, args.seed, spec,
+                             progress=not args.no_progress)
+        near, far = family.attitude_spread()
+        print(f"static poses at dorsal {args.dorsal} m: {family.settled.sum()} of "
+              f"{args.pose_family} settled; attitude differs by a median {near:.1f} deg between "
+              f"heads within 15 mm, {far:.1f} deg between heads over 100 mm apart")
     for path in written:
         print(f"wrote {path}")
     print(f"done in {time.perf_counter() - start:.1f} s")
