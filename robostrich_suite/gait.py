@@ -139,6 +139,20 @@ class TrotGait:
         return 1.0 / self.frequency
 
 
+@dataclasses.dataclass
+class Standing:
+    """Feet under the hips at the commanded trunk height: the standing quadruped."""
+    trunk_height: float = quad.STANDING_TRUNK_HEIGHT
+
+    def joint_targets(self, t, trunk_height=None) -> np.ndarray:
+        height = self.trunk_height if trunk_height is None else trunk_height
+        check_trunk_height(height)
+        shape = np.shape(t) + (4,)
+        hip, knee = leg_ik(np.zeros(shape), -np.broadcast_to(_foot_depth(height), np.shape(t))[
+            ..., None] * np.ones(shape))
+        return _assemble(hip, knee)
+
+
 class GaitReplay:
     """Recorded joint targets over time, linearly interpolated and looped."""
 
