@@ -249,9 +249,9 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
     Attach it to a frame or a robot with ``site.attach(build_arm())``; all names
     are then prefixed ``arm/``.  The base body holds the tendon anchors.
     """
-    spec = spec or ArmSpec.from_table1()
-    layout = layout or TendonLayout.robostrich(spec)
+    spec = ArmSpec.from_table1() if spec is None else spec
     spec.validate()
+    layout = TendonLayout.robostrich(spec) if layout is None else layout
     layout.validate(spec)
 
     model = mjcf.RootElement(model=ARM_MODEL_NAME)
@@ -403,3 +403,9 @@ def head_attitude_deg(physics) -> float:
     """Head attitude in the world's x-z plane: 0 up, 90 level (paper Fig. 2B), 180 down."""
     axis = head_axis(physics)
     return float(np.degrees(np.arctan2(axis[0], axis[2])))
+
+
+def reach(spec: ArmSpec) -> float:
+    """Distance from the base joint to the head site with the neck straight (m): no
+    pose puts the head farther from the base joint than this."""
+    return float(sum(spec.link_lengths) + spec.head_site_fraction * spec.head_length)

@@ -26,6 +26,7 @@ CONTROL_TIMESTEP = 0.008  # s (paper Sec. 4.2)
 PHYSICS_TIMESTEP = 0.002  # s; 4 substeps per control step
 DEFAULT_TIME_LIMIT = 2.0  # s
 TRACK_STEPS_PER_TARGET = 250
+XML_PRECISION = 10  # significant digits in the generated MJCF (readable, and exact enough)
 
 SUITE = containers.TaggedTasks()
 
@@ -34,7 +35,7 @@ def get_model_and_assets(arm_spec=None, tendon_layout=None):
     """The MJCF of the arm on its frame, generated from Table 1 (no assets)."""
     model = arm_lib.build_frame_arm(arm_spec, tendon_layout)
     model.option.timestep = PHYSICS_TIMESTEP
-    return model.to_xml_string(), {}
+    return model.to_xml_string(precision=XML_PRECISION), {}
 
 
 class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):

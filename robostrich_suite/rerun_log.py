@@ -1,0 +1,125 @@
+"""Drawing a MuJoCo model in Rerun: shapes once, body poses per step.
+
+Every body becomes an entity ``{root}/bodies/{body}`` whose ``Transform3D``
+is logged each step; its geoms are static children in the body frame
+(capsules, boxes, spheres, cylinders as capsules, planes as thin boxes).  One
+piece of code serves the arm on its frame and the arm on the quadruped.
+
+    rec = rerun_log.recording("robostrich", "out/rollout.rrd")
+    rerun_log.log_geometry(rec, physics)
+    for t in ...:
+        rerun_log.set_sim_time(rec, physics.data.time)
+        rerun_log.log_body_poses(rec, physics)
+    rec.flush()
+
+Time is on the ``sim_time`` timeline (seconds).  Rerun quaternions are xyzw;
+MuJoCo's are wxyz.
+"""
+from __future__ import annotations
+
+import pathlib
+import re
+
+import mujoco
+import numpy as np
+import rerun as rr
+
+SIM_TIME = "sim_time"
+
+
+def recording(app_id: str, path: str | pathlib.Path) -> rr.RecordingStream:
+    """A recording stream that writes to ``path`` (an ``.rrd`` file)."""
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    rec = rr.RecordingStream(app_id)
+    rec.save(str(path))
+    return rec
+
+
+def set_sim_time(rec: rr.RecordingStream, seconds: float) -> None:
+    rec.set_time(SIM_TIME, duration=float(seconds))
+
+
+def _xyzw(wxyz) -> np.ndarray:
+    wxyz = np.asarray(wxyz, dtype=np.float64)
+    return np.array([wxyz[1], wxyz[2], wxyz[3], wxyz[0]])
+
+
+def _entity(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_\-]", "_", name) or "unnamed"
+
+
+def body_entity(physics, body_id: int, root: str = "world") -> str:
+    name = physics.model.id2name(body_id, "body") or f"body_{body_id}"
+    return f"{root}/bodies/{_entity(name)}"
+
+
+def _rgba(rgba) -> list[int]:
+    return [int(round(255 * float(np.clip(c, 0, 1)))) for c in rgba]
+
+
+def log_geometry(rec: rr.RecordingStream, physics, root: str = "world",
+                 skip_planes: bool = False) -> None:
+    """Log every visible geom as a static shape in its body's frame."""
+    model = physics.model
+    types = mujoco.mjtGeom
+    for geom_id in range(model.ngeom):
+        rgba = model.geom_rgba[geom_id]
+        if rgba[3] == 0:
+            continue
+        body = body_entity(physics, int(model.geom_bodyid[geom_id]), root)
+        name = _entity(model.id2name(geom_id, "geom") or f"geom_{geom_id}")
+        size = model.geom_size[geom_id]
+        pos = model.geom_pos[geom_id]
+        quat = model.geom_quat[geom_id]
+        geom_type = model.geom_type[geom_id]
+        color = [_rgba(rgba)]
+        if geom_type in (types.mjGEOM_CAPSULE, types.mjGEOM_CYLINDER):
+            rotation = np.zeros(9)
+            mujoco.mju_quat2Mat(rotation, quat)
+            start = pos - rotation.reshape(3, 3) @ np.array([0, 0, size[1]])
+            shape = rr.Capsules3D(lengths=[2 * size[1]], radii=[size[0]], translations=[start],
+                                  quaternions=[_xyzw(quat)], colors=color)
+        elif geom_type == types.mjGEOM_BOX:
+            shape = rr.Boxes3D(half_sizes=[size], centers=[pos], quaternions=[_xyzw(quat)],
+                               colors=color)
+        elif geom_type == types.mjGEOM_SPHERE:
+            shape = rr.Ellipsoids3D(half_sizes=[[size[0]] * 3], centers=[pos], colors=color)
+        elif geom_type == types.mjGEOM_ELLIPSOID:
+            shape = rr.Ellipsoids3D(half_sizes=[size], centers=[pos], quaternions=[_xyzw(quat)],
+                                    colors=color)
+        elif geom_type == types.mjGEOM_PLANE and not skip_planes:
+            half = [size[0] or 2.0, size[1] or 2.0, 0.001]
+            shape = rr.Boxes3D(half_sizes=[half], centers=[pos], quaternions=[_xyzw(quat)],
+                               colors=[[90, 100, 110, 255]], fill_mode="solid")
+        else:
+            continue
+        rec.log(f"{body}/{name}", shape, static=True)
+
+
+def log_body_poses(rec: rr.RecordingStream, physics, root: str = "world") -> None:
+    """Log the world pose of every body (at the current time)."""
+    data, model = physics.data, physics.model
+    for body_id in range(1, model.nbody):
+        rec.log(body_entity(physics, body_id, root),
+                rr.Transform3D(translation=data.xpos[body_id],
+                               quaternion=_xyzw(data.xquat[body_id])))
+
+
+def log_scalars(rec: rr.RecordingStream, prefix: str, values: dict) -> None:
+    """Log each ``name: value`` as a scalar series under ``prefix/name``."""
+    for name, value in values.items():
+        rec.log(f"{prefix}/{_entity(name)}", rr.Scalars(np.atleast_1d(np.asarray(value, float))))
+
+
+def log_path(rec: rr.RecordingStream, entity: str, points, color=(255, 60, 60)) -> None:
+    """A polyline, e.g. the head's path so far."""
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if len(points) >= 2:
+        rec.log(entity, rr.LineStrips3D([points], colors=[color]))
+
+
+def log_targets(rec: rr.RecordingStream, entity: str, points, radius: float = 0.01,
+                color=(40, 200, 40), static: bool = True) -> None:
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    rec.log(entity, rr.Points3D(points, radii=radius, colors=[color]), static=static)

@@ -1,0 +1,60 @@
+"""The generated MJCF of the default models, as checked in under ``xml/``.
+
+``xml/`` lets a user open the robots in plain MuJoCo (``simulate``,
+``mujoco.MjModel.from_xml_path``) without this package.  A test fails when a
+checked-in file differs from what the generators produce now; regenerate with
+``python tools/export_xml.py``.
+"""
+from __future__ import annotations
+
+import pathlib
+
+REPO_XML_DIR = pathlib.Path(__file__).resolve().parent.parent / "xml"
+
+
+def _robostrich():
+    from robostrich_suite import robostrich
+    return robostrich.get_model_and_assets()[0]
+
+
+def _robostrich_a1():
+    from robostrich_suite import robostrich_a1
+    return robostrich_a1.get_model_and_assets()[0]
+
+
+def generators() -> dict:
+    """File name -> function returning that model's XML string."""
+    models = {"robostrich.xml": _robostrich}
+    try:
+        import robostrich_suite.robostrich_a1  # noqa: F401
+    except ImportError:
+        pass
+    else:
+        models["robostrich_a1.xml"] = _robostrich_a1
+    return models
+
+
+def export(directory: pathlib.Path = REPO_XML_DIR) -> list[pathlib.Path]:
+    """Write every default model's XML into ``directory``; returns the paths."""
+    directory = pathlib.Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, generate in generators().items():
+        path = directory / name
+        path.write_text(generate())
+        written.append(path)
+    return written
+
+
+def main(argv=None) -> None:
+    import argparse
+    parser = argparse.ArgumentParser(description="Write the generated MJCF of the default models.")
+    parser.add_argument("--out", type=pathlib.Path, default=REPO_XML_DIR,
+                        help="directory to write into (default: the repository's xml/)")
+    args = parser.parse_args(argv)
+    for path in export(args.out):
+        print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,153 @@
+"""The generated arm matches Table 1 and its tendons act the way a neck's muscles do."""
+import dataclasses
+
+import mujoco
+import numpy as np
+import pytest
+from dm_control import mjcf
+
+from robostrich_suite import arm, table1, xml_export
+from robostrich_suite.robostrich import Physics, get_model_and_assets
+
+
+@pytest.fixture(scope="module")
+def physics():
+    return Physics.from_xml_string(*get_model_and_assets())
+
+
+def test_table1_totals():
+    assert table1.TOTAL_MASS_G == 287
+    assert table1.TOTAL_LENGTH_MM == pytest.approx(611.4)
+    assert len(table1.rows()) == 18
+
+
+def test_joints_match_table1_in_radians(physics):
+    names = physics.arm_joint_names()
+    assert names == [f"arm/{n}" for n in table1.JOINT_NAMES]
+    ranges = physics.named.model.jnt_range[names]
+    np.testing.assert_allclose(ranges[:, 0], -np.radians(table1.DORSAL_LIMIT_DEG), atol=1e-12)
+    np.testing.assert_allclose(ranges[:, 1], np.radians(table1.VENTRAL_LIMIT_DEG), atol=1e-12)
+    assert np.all(physics.model.jnt_limited[[physics.model.name2id(n, "joint") for n in names]])
+
+
+def test_link_lengths_are_distances_between_joint_axes(physics):
+    physics.reset()
+    anchors = np.array(physics.named.data.xanchor[physics.arm_joint_names()])  # atlas first
+    distances = np.linalg.norm(np.diff(anchors, axis=0), axis=1)  # atlas-C2, C2-C3, ...
+    expected = np.array(table1.LENGTH_MM[1:]) / 1000.0  # link C2 spans atlas..C2 joints
+    np.testing.assert_allclose(distances, expected, atol=1e-9)
+
+
+def test_masses_match_table1(physics):
+    bodies = [f"arm/{n}" for n in table1.JOINT_NAMES]
+    np.testing.assert_allclose(physics.named.model.body_mass[bodies],
+                               np.array(table1.MASS_G) / 1000.0, atol=1e-12)
+    assert physics.named.model.body_mass[bodies].sum() == pytest.approx(0.287, abs=1e-12)
+
+
+def test_default_layout_is_one_dorsal_and_eight_ventral():
+    layout = arm.TendonLayout.robostrich()
+    assert [t.side for t in layout.tendons] == ["dorsal"] + ["ventral"] * 8
+    assert layout.tendons[0].insertion == "atlas"
+    assert [t.insertion for t in layout.tendons[1:]] == list(
+        arm.TendonLayout.ROBOSTRICH_VENTRAL_INSERTIONS)
+    assert all(t.links[0] == "c18" for t in layout.tendons)
+
+
+def test_every_tendon_only_pulls(physics):
+    assert np.all(physics.model.actuator_forcerange[:, 1] == 0)
+    assert np.all(physics.model.actuator_forcerange[:, 0] < 0)
+    low, high = physics.model.actuator_ctrlrange.T
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        physics.reset()
+        physics.data.ctrl[:] = rng.uniform(low, high)
+        for _ in range(100):
+            physics.step()
+            assert np.all(physics.tendon_forces() >= 0)
+
+
+def _settle(physics, ctrl, steps=600):
+    physics.reset()
+    physics.data.ctrl[:] = ctrl
+    physics.step(steps)
+    return physics.head_position(), physics.head_attitude()
+
+
+def test_ventral_tendons_flex_forward_and_dorsal_tendon_extends_back(physics):
+    rest_head, rest_attitude = _settle(physics, np.zeros(9))
+    np.testing.assert_allclose(rest_head[[0, 2]], [0, 0.05 + 0.03 + arm.reach(
+        arm.ArmSpec.from_table1())], atol=2e-3)  # upright
+    assert abs(rest_attitude) < 1.0
+    ventral = np.zeros(9)
+    ventral[0] = physics.model.actuator_ctrlrange[0, 0]  # let the dorsal tendon pay out
+    ventral[1:] = 0.5 * physics.model.actuator_ctrlrange[1:, 1]
+    head, attitude = _settle(physics, ventral)
+    assert head[0] > rest_head[0] + 0.15  # head forward (ventral side is +x)
+    assert head[2] < rest_head[2] - 0.1  # and lower
+    assert attitude > 45  # head pitched forward/down
+    dorsal = np.zeros(9)
+    dorsal[0] = 0.03
+    dorsal[1:] = physics.model.actuator_ctrlrange[1:, 0]
+    head, attitude = _settle(physics, dorsal)
+    assert head[0] < rest_head[0] - 0.1  # head backward
+    assert attitude < -30
+
+
+def test_checked_in_xml_is_up_to_date():
+    for name, generate in xml_export.generators().items():
+        path = xml_export.REPO_XML_DIR / name
+        assert path.exists(), f"xml/{name} is missing: run python tools/export_xml.py"
+        assert path.read_text() == generate(), (
+            f"xml/{name} is out of date: run python tools/export_xml.py")
+
+
+def test_checked_in_xml_loads_in_plain_mujoco():
+    model = mujoco.MjModel.from_xml_path(str(xml_export.REPO_XML_DIR / "robostrich.xml"))
+    assert (model.njnt, model.ntendon, model.nu) == (18, 9, 9)
+
+
+def test_generator_takes_another_spec_and_layout():
+    spec = arm.ArmSpec(joint_names=("head", "n2", "n3", "n4"), dorsal_limits_deg=(5, 20, 20, 20),
+                       ventral_limits_deg=(5, 20, 20, 20), link_lengths=(0.05, 0.05, 0.05),
+                       masses=(0.05, 0.01, 0.01, 0.01))
+    layout = arm.TendonLayout((
+        arm.TendonSpec("back", "dorsal", ("n4", "n3", "n2", "head")),
+        arm.TendonSpec("front_low", "ventral", ("n4", "n3")),
+        arm.TendonSpec("front_high", "ventral", ("n4", "n2"))))  # skips the n3 hole
+    physics = mjcf.Physics.from_mjcf_model(arm.build_frame_arm(spec, layout))
+    assert (physics.model.njnt, physics.model.nu) == (4, 3)
+    assert physics.model.tendon_num.tolist() == [5, 3, 3]  # anchor + holes
+
+
+@pytest.mark.parametrize("change, message", [
+    (dict(masses=(0.083,) + (-0.005,) + (0.01,) * 16), "link 'c2': mass"),
+    (dict(dorsal_limits_deg=(1, -12) + (10,) * 16), "joint 'c2': dorsal limit"),
+    (dict(ventral_limits_deg=(1, 12, -16) + (10,) * 15), "joint 'c3': ventral limit"),
+    (dict(link_lengths=(0.0071, 0.0) + (0.04,) * 15), "link 'c3': length"),
+    (dict(link_lengths=(0.01,) * 3), "link_lengths has 3 entries"),
+    (dict(joint_names=("atlas",) + ("c2",) * 17), "duplicate joint/link names"),
+])
+def test_bad_spec_raises_naming_the_item(change, message):
+    spec = dataclasses.replace(arm.ArmSpec.from_table1(), **change)
+    with pytest.raises(ValueError, match=message):
+        arm.build_arm(spec)
+
+
+@pytest.mark.parametrize("tendons, message", [
+    ((arm.TendonSpec("t", "ventral", ("c18", "c99")),), "unknown link 'c99'"),
+    ((arm.TendonSpec("t", "ventral", ("c18",)),), "at least two"),
+    ((arm.TendonSpec("t", "ventral", ("c18", "c17")),
+      arm.TendonSpec("t", "dorsal", ("c18", "c17"))), "duplicate tendon name 't'"),
+    ((arm.TendonSpec("t", "lateral", ("c18", "c17")),), "unknown side 'lateral'"),
+    ((arm.TendonSpec("t", "ventral", ("c17", "c18")),), "caudal to cranial"),
+    ((), "at least one tendon"),
+])
+def test_bad_layout_raises_naming_the_item(tendons, message):
+    with pytest.raises(ValueError, match=message):
+        arm.build_arm(layout=arm.TendonLayout(tendons))
+
+
+def test_spanning_rejects_unknown_insertion():
+    with pytest.raises(ValueError, match="unknown link 'neck'"):
+        arm.TendonSpec.spanning("t", "ventral", "neck", arm.ArmSpec.from_table1())
