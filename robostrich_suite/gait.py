@@ -301,7 +301,7 @@ def write_gait_file(path, times, targets, comment: str | None = None) -> None:
             out.write(f"# {line}\n")
     out.write(",".join(COLUMNS) + "\n")
     for t, row in zip(times, targets):
-        out.write(",".join([f"{t:.4f}"] + [f"{v:.6f}" for v in row]) + "\n")
+        out.write(",".join([f"{t:.6f}"] + [f"{v:.6f}" for v in row]) + "\n")
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(out.getvalue())
