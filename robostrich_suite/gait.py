@@ -44,7 +44,7 @@ COLUMNS = ("time",) + quad.JOINT_NAMES
 L1, L2 = quad.THIGH_LENGTH, quad.CALF_LENGTH
 # Trunk heights the legs can hold while trotting (knee limits with the stride's reach).
 MIN_TRUNK_HEIGHT = 0.16  # m
-MAX_TRUNK_HEIGHT = 0.33  # m
+MAX_TRUNK_HEIGHT = 0.35  # m
 # Phase offset of each leg (FR, FL, RR, RL): diagonal pairs half a cycle apart.
 TROT_PHASES = np.array([0.0, 0.5, 0.5, 0.0])
 

@@ -60,7 +60,20 @@ LESSON_TIME_LIMIT = 2.0  # s, lessons 1-3 (as in ``robostrich``)
 LESSON4_TIME_LIMIT = 6.0  # s: stand-in, lowered/raised, back (one height change)
 HEAD_STABILIZE_TIME_LIMIT = 12.0  # s (1500 steps, Fig. 9)
 NARROW_GAP_STEPS_PER_TARGET = 150  # control steps = 1.2 s per sub-target
-FALL_UPRIGHTNESS = 0.5  # trunk z-axis z component below this = fallen over
+# The leg servos (kp 100) sag under the robot's weight: measured trunk height minus
+# command, at 0.22-0.28 m, is -0.010 m standing and -0.019 m on average while trotting.
+# The tasks command the legs that much higher so the trunk's height matches the command.
+SAG_COMPENSATION = {"stand": 0.010, "walk": 0.019}  # m
+FALL_UPRIGHTNESS = 0.5
+# Steering on top of the open-loop gait: an open-loop trot wanders 10-20 deg in yaw
+# and drifts sideways.  Like the real A1's own controller, the task keeps the walk on
+# the +x line through the start: the desired yaw leans back towards the line, and the
+# stride of the left legs is lengthened (right legs shortened) in proportion to the
+# yaw error.
+STEER_YAW_GAIN = 1.0  # stride change (fraction) per rad of yaw error
+STEER_LINE_GAIN = 1.5  # rad of desired yaw per m off the line
+STEER_MAX_YAW = 0.3  # rad
+STEER_MAX_STRIDE_CHANGE = 0.5  # trunk z-axis z component below this = fallen over
 ARM_PREFIX = f"{quad.MODEL_NAME}/{arm_lib.ARM_MODEL_NAME}/"
 TRUNK = f"{quad.MODEL_NAME}/{quad.TRUNK_BODY}"
 
@@ -286,7 +299,7 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
 
     def place_standing(self, trunk_xy=(0.0, 0.0), trunk_height=quad.STANDING_TRUNK_HEIGHT):
         """Put the quadruped in its standing pose, feet on the ground, arm straight, at rest."""
-        targets = gait_lib.Standing().joint_targets(0.0, trunk_height)
+        targets = gait_lib.Standing().joint_targets(0.0, trunk_height + SAG_COMPENSATION["stand"])
         _, foot_z = gait_lib.leg_fk(targets[1], targets[2])
         self.data.qpos[:] = 0.0
         self.data.qpos[:3] = [trunk_xy[0], trunk_xy[1], -foot_z + quad.FOOT_RADIUS]
@@ -325,6 +338,9 @@ FALLBACK_FRAME_TARGETS = np.array([
     [0.368, 0.169], [0.087, 0.587], [-0.003, 0.396], [0.385, 0.183]])
 
 
+_LEFT_SIGN = np.array([1.0 if leg.endswith("L") else -1.0 for leg in quad.LEGS])
+
+
 class _QuadrupedTaskMixin:
     """What every ``robostrich_a1`` task shares: legs driven by a gait, tendon-only
     actions, Table 2 observations in the trunk frame, episodes starting from standing.
@@ -335,9 +351,11 @@ class _QuadrupedTaskMixin:
         file path; default: replay of the shipped file.
       trunk_heights: a :class:`gait.TrunkHeightSchedule`, a callable ``random ->
         schedule`` (a new schedule each episode), or ``None`` (constant nominal height).
+      steer: keep the walk on the start line (see ``STEER_*``); off = the pure open-loop gait.
     """
 
-    def __init__(self, *, legs: str = "stand", gait=None, trunk_heights=None, **kwargs):
+    def __init__(self, *, legs: str = "stand", gait=None, trunk_heights=None, steer: bool = True,
+                 **kwargs):
         if legs not in ("stand", "walk"):
             raise ValueError(f"unknown legs {legs!r}; use 'stand' or 'walk'")
         if legs == "walk":
@@ -349,6 +367,7 @@ class _QuadrupedTaskMixin:
             gait = gait_lib.Standing()
         self.legs = legs
         self.gait = gait
+        self.steer = bool(steer)
         self._trunk_heights = trunk_heights
         self.height_schedule = gait_lib.TrunkHeightSchedule()
         self._episode_start_time = 0.0
@@ -357,15 +376,15 @@ class _QuadrupedTaskMixin:
 
     # Episode.
     def initialize_episode(self, physics):
-        continuing = self.initial_state == "continue" and self._last_state is not None
-        if not continuing:
-            physics.place_standing()
-            physics.forward()
-            physics.step(int(round(SETTLE_TIME / physics.model.opt.timestep)))
         schedule = self._trunk_heights
         if callable(schedule) and not isinstance(schedule, gait_lib.TrunkHeightSchedule):
             schedule = schedule(self.random)
         self.height_schedule = schedule or gait_lib.TrunkHeightSchedule()
+        continuing = self.initial_state == "continue" and self._last_state is not None
+        if not continuing:
+            physics.place_standing(trunk_height=float(self.height_schedule(0.0)))
+            physics.forward()
+            physics.step(int(round(SETTLE_TIME / physics.model.opt.timestep)))
         super().initialize_episode(physics)
         self._episode_start_time = physics.data.time
         self._episode_start_xy = physics.trunk_position()[:2]
@@ -374,9 +393,30 @@ class _QuadrupedTaskMixin:
     def episode_time(self, physics) -> float:
         return physics.data.time - self._episode_start_time
 
+    def trunk_height_command(self, physics) -> float:
+        return float(self.height_schedule(self.episode_time(physics)))
+
     def leg_targets(self, physics) -> np.ndarray:
         t = self.episode_time(physics)
-        return self.gait.joint_targets(t, float(self.height_schedule(t)))
+        height = float(self.height_schedule(t)) + SAG_COMPENSATION[self.legs]
+        targets = self.gait.joint_targets(t, height)
+        if self.legs == "walk" and self.steer:
+            targets = self.steer_targets(physics, targets)
+        return targets
+
+    def steer_targets(self, physics, targets) -> np.ndarray:
+        """Scale each leg's fore-aft foot travel to turn back onto the walking line."""
+        off_line = physics.trunk_position()[1] - self._episode_start_xy[1]
+        desired = -np.clip(STEER_LINE_GAIN * off_line, -STEER_MAX_YAW, STEER_MAX_YAW)
+        heading = physics.heading()
+        error = np.arctan2(heading[1], heading[0]) - desired
+        change = np.clip(STEER_YAW_GAIN * error, -STEER_MAX_STRIDE_CHANGE, STEER_MAX_STRIDE_CHANGE)
+        scale = 1.0 + change * _LEFT_SIGN  # yawed left (error > 0): left legs step longer
+        x, z = gait_lib.leg_fk(targets[1::3], targets[2::3])
+        hip, knee = gait_lib.leg_ik(x * scale, z)
+        out = targets.copy()
+        out[1::3], out[2::3] = hip, knee
+        return out
 
     def before_step(self, action, physics):
         action = np.asarray(action, dtype=np.float64)
@@ -463,7 +503,9 @@ class NarrowGap(_QuadrupedTaskMixin, reach.Track):
             return super().leg_targets(physics)
         t_stop, last = self._stopped_at
         blend = min((t - t_stop) / 0.3, 1.0)
-        return (1 - blend) * last + blend * gait_lib.Standing().joint_targets(t)
+        standing = gait_lib.Standing().joint_targets(
+            t, self.trunk_height_command(physics) + SAG_COMPENSATION["stand"])
+        return (1 - blend) * last + blend * standing
 
     def walking(self) -> bool:
         return self._stopped_at is None
