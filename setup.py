@@ -27,7 +27,7 @@ setup(
         "tqdm==4.70.1",  # progress bars on training and sampling
     ],
     extras_require={
-        "test": ["pytest==9.2.0", "pytest-xdist==3.8.0"],
+        "test": ["pytest==9.2.0", "pytest-xdist==3.8.0", "gymnasium==1.4.0"],
         "gym": ["gymnasium==1.4.0"],
     },
     entry_points={

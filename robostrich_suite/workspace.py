@@ -23,9 +23,17 @@ LEVEL_TOLERANCE_DEG = 5.0
 
 def model_fingerprint(spec: arm_lib.ArmSpec | None = None,
                       layout: arm_lib.TendonLayout | None = None) -> str:
-    """Short hash of the generated arm; a pose set from another arm is stale."""
-    xml = arm_lib.build_frame_arm(spec, layout).to_xml_string()
-    return hashlib.sha256(xml.encode()).hexdigest()[:16]
+    """Short hash of what decides where the arm comes to rest; a pose set made with
+    another arm is stale.  Colours, names and sensors do not count."""
+    model = frame_physics(spec, layout).model
+    digest = hashlib.sha256()
+    for field in ("body_pos", "body_quat", "body_mass", "body_inertia", "jnt_range",
+                  "jnt_stiffness", "jnt_solref", "jnt_solimp", "dof_damping", "dof_armature",
+                  "site_pos", "geom_size", "actuator_gainprm", "actuator_biasprm",
+                  "actuator_ctrlrange", "actuator_forcerange", "wrap_objid"):
+        digest.update(np.round(np.asarray(getattr(model, field), np.float64), 9).tobytes())
+    digest.update(np.array([model.opt.timestep, model.opt.integrator], np.float64).tobytes())
+    return digest.hexdigest()[:16]
 
 
 def frame_physics(spec=None, layout=None) -> mjcf.Physics:

@@ -1,0 +1,39 @@
+"""The gymnasium adapter exposes the same task with gymnasium's contract."""
+import numpy as np
+from gymnasium.utils.env_checker import check_env
+
+from robostrich_suite import gym_adapter
+
+
+def test_passes_gymnasiums_checker():
+    env = gym_adapter.make("robostrich", "lesson1", seed=0, time_limit=0.08)
+    check_env(env, skip_render_check=True)
+
+
+def test_episode_ends_truncated_and_observation_matches_dm_env():
+    env = gym_adapter.make("robostrich", "lesson2", seed=0, time_limit=0.08)
+    obs, _ = env.reset(seed=3)
+    assert obs.shape == env.observation_space.shape == (46,)
+    joints = env.observation_slices["joint_angles"]
+    np.testing.assert_array_equal(obs[joints], np.zeros(18, np.float32))
+    steps, done = 0, False
+    while not done:
+        obs, reward, terminated, truncated, _ = env.step(np.full(9, 0.5, np.float32))
+        steps += 1
+        done = terminated or truncated
+    assert truncated and not terminated and steps == 10
+    head = env.dm_env.physics.head_position()[[0, 2]]
+    np.testing.assert_allclose(obs[env.observation_slices["head_position"]], head, rtol=1e-6)
+    assert reward < 0
+
+
+def test_normalized_actions_map_onto_the_tendon_range():
+    env = gym_adapter.make("robostrich", "lesson1", seed=0)
+    spec = env.dm_env.action_spec()
+    env.reset(seed=0)
+    env.step(-np.ones(9, np.float32))
+    np.testing.assert_allclose(env.dm_env.physics.data.ctrl, spec.minimum)
+    env.step(np.zeros(9, np.float32))
+    np.testing.assert_allclose(env.dm_env.physics.data.ctrl, (spec.minimum + spec.maximum) / 2)
+    raw = gym_adapter.make("robostrich", "lesson1", seed=0, normalize_actions=False)
+    np.testing.assert_allclose(raw.action_space.high, spec.maximum.astype(np.float32))

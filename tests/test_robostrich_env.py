@@ -1,0 +1,209 @@
+"""The robostrich domain: dm_env conformance, rewards, determinism, bad input."""
+import logging
+
+import numpy as np
+import pytest
+from absl.testing import absltest
+from dm_env import test_utils
+
+import robostrich_suite
+from robostrich_suite import reach, rewards, targets
+
+TASKS = robostrich_suite.TASKS_BY_DOMAIN["robostrich"]
+
+
+def test_registry_lists_the_lessons_and_track():
+    assert TASKS == ("lesson1", "lesson2", "lesson3", "track")
+    assert ("robostrich", "lesson3") in robostrich_suite.ALL_TASKS
+    assert ("robostrich", "track") not in robostrich_suite.CURRICULUM_TASKS
+
+
+def test_unknown_names_get_clear_errors():
+    with pytest.raises(ValueError, match="unknown domain 'ostrich'"):
+        robostrich_suite.load("ostrich", "lesson1")
+    with pytest.raises(ValueError, match="no task 'lesson9'"):
+        robostrich_suite.load("robostrich", "lesson9")
+    with pytest.raises(TypeError):
+        robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(no_such_option=1))
+
+
+def _conformance_case(task_name):
+    class Case(test_utils.EnvironmentTestMixin, absltest.TestCase):
+        def make_object_under_test(self):
+            return robostrich_suite.load("robostrich", task_name, task_kwargs=dict(
+                random=0, time_limit=0.08) if task_name != "track" else dict(
+                    random=0, steps_per_target=4))
+    Case.__name__ = f"Conformance_{task_name}"
+    return Case
+
+
+for _task in TASKS:
+    globals()[f"TestConformance_{_task}"] = _conformance_case(_task)
+
+
+@pytest.mark.parametrize("task_name", TASKS)
+def test_every_task_has_a_nine_tendon_action(task_name):
+    env = robostrich_suite.load("robostrich", task_name, task_kwargs=dict(random=0))
+    spec = env.action_spec()
+    assert spec.shape == (9,)
+    assert np.all(spec.minimum < 0) and np.all(spec.maximum > 0)
+    assert env.control_timestep() == pytest.approx(0.008)
+
+
+def test_observation_names_and_sizes():
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=0))
+    shapes = {k: v.shape for k, v in env.observation_spec().items()}
+    assert shapes == {"head_position": (2,), "head_velocity": (2,), "joint_angles": (18,),
+                      "target_position": (2,), "to_target": (2,), "attitude_error": (1,),
+                      "head_attitude": (1,), "tendon_contraction": (9,),
+                      "tendon_tension": (9,)}
+
+
+def _pose_env(task_name, target):
+    env = robostrich_suite.load("robostrich", task_name,
+                                task_kwargs=dict(random=0, target_pool=[target]))
+    env.reset()
+    return env
+
+
+def _bend(physics, angle_rad):
+    with physics.reset_context():
+        physics.data.qpos[:] = angle_rad
+
+
+def test_lesson1_reward_is_eq9():
+    env = _pose_env("lesson1", [0.3, 0.4])
+    physics, task = env.physics, env.task
+    _bend(physics, 0.05)
+    head = np.array(physics.named.data.site_xpos["arm/head"])[[0, 2]]
+    assert task.get_reward(physics) == -1.0  # far from (0.3, 0.4)
+    task.target_position = head + np.array([0.03, 0.0])
+    assert task.get_reward(physics) == 0.0  # within d = 0.05
+    task.target_position = head + np.array([0.0, 0.051])
+    assert task.get_reward(physics) == -1.0
+
+
+def test_lesson2_reward_is_eq10():
+    env = _pose_env("lesson2", [0.3, 0.4])
+    physics, task = env.physics, env.task
+    _bend(physics, 0.08)
+    head = np.array(physics.named.data.site_xpos["arm/head"])[[0, 2]]
+    axis = np.array(physics.named.data.xmat["arm/atlas"]).reshape(3, 3)[:, 2]
+    attitude = np.degrees(np.arctan2(axis[0], axis[2]))
+    assert attitude == pytest.approx(np.degrees(0.08 * 18), abs=1e-6)  # 18 joints bent equally
+    error = np.linalg.norm(head - [0.3, 0.4])
+    w = task.weights
+    expected = (-w.position_miss * (error > 0.05) - w.attitude_miss * (abs(attitude - 90) > 5)
+                - w.position_error * error - w.attitude_error * abs(attitude - 90))
+    assert task.get_reward(physics) == pytest.approx(expected, abs=1e-9)
+    # Inside both tolerances only the shaping terms remain.
+    task.target_position = head + [0.01, 0.0]
+    task.desired_attitude = attitude + 2.0
+    assert task.get_reward(physics) == pytest.approx(
+        -w.position_error * 0.01 - w.attitude_error * 2.0, abs=1e-9)
+
+
+def test_reward_weights_are_task_kwargs():
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(
+        random=0, weights=dict(position_miss=0, attitude_miss=0, position_error=1,
+                               attitude_error=0)))
+    env.reset()
+    error = env.task.position_error(env.physics)
+    assert env.task.get_reward(env.physics) == pytest.approx(-error)
+    assert rewards.lesson2_reward(0.0, 0.0, 0.05, 5.0) == 0.0
+
+
+def _rollout(seed, actions):
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=seed))
+    ts = env.reset()
+    states = [ts.observation["target_position"].copy()]
+    for action in actions:
+        ts = env.step(action)
+        states.append(np.concatenate([env.physics.data.qpos, env.physics.data.qvel, [ts.reward]]))
+    return states
+
+
+def test_same_seed_same_actions_same_trajectory():
+    rng = np.random.default_rng(3)
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=0))
+    spec = env.action_spec()
+    actions = rng.uniform(spec.minimum, spec.maximum, size=(60, 9))
+    first, second = _rollout(7, actions), _rollout(7, actions)
+    for a, b in zip(first, second):
+        np.testing.assert_array_equal(a, b)
+    other = _rollout(8, actions)
+    assert not np.array_equal(first[0], other[0])  # another seed, another target
+
+
+def test_nan_action_raises_and_out_of_range_is_clipped():
+    env = robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(random=0))
+    env.reset()
+    action = np.zeros(9)
+    action[4] = np.nan
+    with pytest.raises(ValueError, match=r"non-finite values at indices \[4\]"):
+        env.step(action)
+    spec = env.action_spec()
+    env.step(np.full(9, 10.0))
+    np.testing.assert_array_equal(env.physics.data.ctrl, spec.maximum)
+    env.step(np.full(9, -10.0))
+    np.testing.assert_array_equal(env.physics.data.ctrl, spec.minimum)
+
+
+def test_divergence_ends_the_episode_with_a_logged_reason(caplog):
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=0))
+    env.reset()
+    env.step(np.zeros(9))
+    env.physics.data.qvel[3] = np.inf
+    with caplog.at_level(logging.WARNING):
+        ts = env.step(np.zeros(9))
+    assert ts.last() and ts.discount == 0.0
+    assert np.isfinite(ts.reward)
+    assert "diverged" in caplog.text
+    ts = env.step(np.zeros(9))  # the next step starts a fresh, finite episode
+    assert ts.first() and np.all(np.isfinite(env.physics.data.qpos))
+
+
+def test_lesson2_starts_fixed_and_lesson3_continues():
+    action = np.full(9, 0.01)
+    for task_name, continues in (("lesson2", False), ("lesson3", True)):
+        env = robostrich_suite.load("robostrich", task_name,
+                                    task_kwargs=dict(random=0, time_limit=0.4))
+        ts = env.reset()
+        np.testing.assert_array_equal(ts.observation["joint_angles"], np.zeros(18))
+        while not ts.last():
+            ts = env.step(action)
+        final = ts.observation["joint_angles"]
+        assert np.abs(final).max() > 0.02
+        ts = env.reset()
+        if continues:
+            np.testing.assert_array_equal(ts.observation["joint_angles"], final)
+        else:
+            np.testing.assert_array_equal(ts.observation["joint_angles"], np.zeros(18))
+
+
+def test_track_visits_targets_in_order():
+    three = np.array([[0.2, 0.3], [0.3, 0.2], [0.1, 0.4]])
+    env = robostrich_suite.load("robostrich", "track",
+                                task_kwargs=dict(random=0, targets=three, steps_per_target=5))
+    ts = env.reset()
+    seen = [ts.observation["target_position"].copy()]
+    count = 0
+    while not ts.last():
+        ts = env.step(np.zeros(9))
+        count += 1
+        seen.append(ts.observation["target_position"].copy())
+        head = env.physics.head_position()[[0, 2]]
+        assert ts.observation["position_error"][0] == pytest.approx(
+            np.linalg.norm(head - ts.observation["target_position"]))
+    assert count == 15
+    np.testing.assert_array_equal(np.unique(np.array(seen), axis=0), np.unique(three, axis=0))
+    np.testing.assert_array_equal(seen[0], three[0])
+    np.testing.assert_array_equal(seen[-1], three[2])
+
+
+def test_default_track_targets_are_held_out_level_poses():
+    env = robostrich_suite.load("robostrich", "track", task_kwargs=dict(random=0))
+    held_out = targets.heldout_targets()
+    assert len(env.task.targets) == 3
+    for target in env.task.targets:
+        assert np.min(np.linalg.norm(held_out - target, axis=1)) == 0.0

@@ -1,0 +1,31 @@
+"""Targets come from poses the arm really held with its head level."""
+import numpy as np
+import pytest
+
+from robostrich_suite import targets, workspace
+
+
+def test_pose_set_was_made_with_the_current_arm():
+    assert str(targets.level_head_poses()["fingerprint"]) == workspace.model_fingerprint(), (
+        "data/level_head_poses.npz is stale: run python -m robostrich_suite.targets")
+
+
+def test_poses_are_level_and_split_without_overlap():
+    poses = targets.level_head_poses()
+    assert len(poses["head_position"]) >= 50
+    assert np.all(np.abs(poses["head_attitude"] - 90) <= 5)
+    train, held_out = targets.training_targets(), targets.heldout_targets()
+    assert len(train) + len(held_out) == len(poses["head_position"])
+    assert len(held_out) >= 10
+    distances = np.linalg.norm(train[:, None] - held_out[None], axis=2)
+    assert distances.min() > 0
+
+
+@pytest.mark.parametrize("index", [0, 7, 21])
+def test_stored_inputs_really_hold_the_head_level_there(index):
+    poses = targets.level_head_poses()
+    physics = workspace.frame_physics()
+    assert workspace.settle(physics, poses["control"][index])
+    np.testing.assert_allclose(workspace.head_position_xz(physics),
+                               poses["head_position"][index], atol=1e-6)
+    assert abs(workspace.head_attitude_deg(physics) - 90) <= 5
