@@ -225,3 +225,19 @@ def test_bad_task_options_raise():
     with pytest.raises(ValueError, match="outside the range"):
         robostrich_suite.load("robostrich_a1", "head_stabilize", task_kwargs=dict(
             trunk_heights=gait.TrunkHeightSchedule((0, 1), (0.27, 0.5))))
+
+
+def test_walk_tool_writes_a_recording_and_a_plot(tmp_path, capsys):
+    a1.main(["--seconds", "0.4", "--tendons", "sine", "--out", str(tmp_path / "walk")])
+    assert (tmp_path / "walk.rrd").stat().st_size > 10_000
+    assert (tmp_path / "walk.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "mean forward speed" in capsys.readouterr().out
+
+
+def test_walk_series_show_the_trot_and_the_scripted_nod():
+    zero = a1.record_walk("lesson4", seconds=1.5, tendons="zero")
+    nod = a1.record_walk("lesson4", seconds=1.5, tendons="sine")
+    assert len(zero["time"]) == round(1.5 / a1.CONTROL_TIMESTEP)
+    assert zero["trunk_speed"].mean() > 0.1
+    # The scripted ventral pull brings the head forward of where the passive neck is.
+    assert nod["head_forward_distance"][-60:].mean() > zero["head_forward_distance"][-60:].mean()
