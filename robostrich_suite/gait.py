@@ -30,6 +30,7 @@ Regenerate the shipped file with ``python -m robostrich_suite.gait``.
 from __future__ import annotations
 
 import argparse
+import bisect
 import csv
 import dataclasses
 import io
@@ -75,11 +76,16 @@ def leg_fk(hip, knee):
 
 
 def check_trunk_height(trunk_height) -> None:
-    height = np.asarray(trunk_height, float)
-    if not np.all(np.isfinite(height)) or np.any(height < MIN_TRUNK_HEIGHT) or np.any(
-            height > MAX_TRUNK_HEIGHT):
-        raise ValueError(f"trunk height {trunk_height} m is outside the range the legs can hold "
-                         f"[{MIN_TRUNK_HEIGHT}, {MAX_TRUNK_HEIGHT}] m")
+    if isinstance(trunk_height, float):  # the per-step path: no numpy overhead
+        if MIN_TRUNK_HEIGHT <= trunk_height <= MAX_TRUNK_HEIGHT:
+            return
+    else:
+        height = np.asarray(trunk_height, float)
+        if (np.all(np.isfinite(height)) and np.all(height >= MIN_TRUNK_HEIGHT)
+                and np.all(height <= MAX_TRUNK_HEIGHT)):
+            return
+    raise ValueError(f"trunk height {trunk_height} m is outside the range the legs can hold "
+                     f"[{MIN_TRUNK_HEIGHT}, {MAX_TRUNK_HEIGHT}] m")
 
 
 def _foot_depth(trunk_height):
@@ -117,6 +123,8 @@ class TrotGait:
 
     def foot_positions(self, t, trunk_height=None):
         """Foot (x, z) from each hip, arrays of shape ``t.shape + (4,)``."""
+        if trunk_height is not None:
+            trunk_height = float(trunk_height) if np.ndim(trunk_height) == 0 else trunk_height
         height = self.trunk_height if trunk_height is None else trunk_height
         check_trunk_height(height)
         t = np.asarray(t, float)[..., None]
@@ -130,9 +138,12 @@ class TrotGait:
         z = -_foot_depth(np.asarray(height, float)[..., None]) + raise_
         return x, z
 
-    def joint_targets(self, t, trunk_height=None) -> np.ndarray:
-        hip, knee = leg_ik(*self.foot_positions(t, trunk_height))
-        return _assemble(hip, knee)
+    def joint_targets(self, t, trunk_height=None, stride_scale=None) -> np.ndarray:
+        """Joint targets; ``stride_scale`` (4,) scales each foot's fore-aft travel (steering)."""
+        x, z = self.foot_positions(t, trunk_height)
+        if stride_scale is not None:
+            x = x * stride_scale
+        return _assemble(*leg_ik(x, z))
 
     @property
     def period(self) -> float:
@@ -144,7 +155,7 @@ class Standing:
     """Feet under the hips at the commanded trunk height: the standing quadruped."""
     trunk_height: float = quad.STANDING_TRUNK_HEIGHT
 
-    def joint_targets(self, t, trunk_height=None) -> np.ndarray:
+    def joint_targets(self, t, trunk_height=None, stride_scale=None) -> np.ndarray:
         height = self.trunk_height if trunk_height is None else trunk_height
         check_trunk_height(height)
         shape = np.shape(t) + (4,)
@@ -165,33 +176,48 @@ class GaitReplay:
         # Depth of the stance feet under the hips: the trunk height the data was recorded at.
         _, foot_z = leg_fk(targets[:, 1::3], targets[:, 2::3])
         self.recorded_trunk_height = float(np.max(-foot_z) + quad.FOOT_RADIUS)
+        # Targets and foot positions side by side, interpolated together: (n, 12 + 4 + 4).
+        self._table = np.concatenate([targets, *leg_fk(targets[:, 1::3], targets[:, 2::3])],
+                                     axis=1)
+        self._t0, self._time_list = float(times[0]), times.tolist()
 
     @classmethod
     def from_file(cls, path=DATA_PATH) -> "GaitReplay":
         return cls(*read_gait_file(path))
 
-    def raw_targets(self, t) -> np.ndarray:
-        """Targets at time(s) ``t`` as recorded: interpolated, looped."""
+    def _interpolate(self, table, t):
+        if np.ndim(t) == 0:  # the per-step path: one bisection, no array temporaries
+            local = self._t0 + (float(t) - self._t0) % self.period
+            upper = min(max(bisect.bisect_right(self._time_list, local), 1), len(self.times) - 1)
+            t0, t1 = self._time_list[upper - 1], self._time_list[upper]
+            below = table[upper - 1]
+            return below + (table[upper] - below) * ((local - t0) / (t1 - t0))
         t = np.asarray(t, float)
         local = self.times[0] + np.mod(t - self.times[0], self.period)
         upper = np.clip(np.searchsorted(self.times, local, side="right"), 1, len(self.times) - 1)
         t0, t1 = self.times[upper - 1], self.times[upper]
         weight = ((local - t0) / (t1 - t0))[..., None]
-        return self.targets[upper - 1] * (1 - weight) + self.targets[upper] * weight
+        return table[upper - 1] * (1 - weight) + table[upper] * weight
 
-    def joint_targets(self, t, trunk_height=None) -> np.ndarray:
-        targets = self.raw_targets(t)
-        if trunk_height is None:
-            return targets
-        check_trunk_height(trunk_height)
-        shift = np.asarray(trunk_height, float) - self.recorded_trunk_height
-        if np.all(shift == 0):
-            return targets
-        x, z = leg_fk(targets[..., 1::3], targets[..., 2::3])
-        hip, knee = leg_ik(x, z - np.asarray(shift)[..., None])
-        out = targets.copy()
-        out[..., 1::3], out[..., 2::3] = hip, knee
-        return out
+    def raw_targets(self, t) -> np.ndarray:
+        """Targets at time(s) ``t`` as recorded: interpolated, looped."""
+        return self._interpolate(self.targets, t)
+
+    def joint_targets(self, t, trunk_height=None, stride_scale=None) -> np.ndarray:
+        """Recorded targets at ``t``; for another trunk height or a stride scale the
+        recorded foot positions (interpolated) are moved and turned back into angles."""
+        if trunk_height is None and stride_scale is None:
+            return self.raw_targets(t)
+        row = self._interpolate(self._table, t)
+        targets, x, z = row[..., :12], row[..., 12:16], row[..., 16:]
+        if trunk_height is not None:
+            trunk_height = float(trunk_height) if np.ndim(trunk_height) == 0 else trunk_height
+            check_trunk_height(trunk_height)
+            z = z - (np.asarray(trunk_height) - self.recorded_trunk_height)[..., None]
+        if stride_scale is not None:
+            x = x * stride_scale
+        targets[..., 1::3], targets[..., 2::3] = leg_ik(x, z)
+        return targets
 
 
 @dataclasses.dataclass

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import collections
 import functools
+import math
 
 import numpy as np
 from dm_control import mjcf, mujoco
@@ -215,11 +216,11 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
 
     def _robot(self):
         cache = self.__dict__.get("_robot_cache")
-        if cache is None or cache["ptr"] is not self.model.ptr:
+        if cache is None or cache["data"] is not self._data:  # a reload makes new data
             model = self.model
             legs = [f"{quad.MODEL_NAME}/{name}" for name in quad.JOINT_NAMES]
             cache = dict(
-                ptr=model.ptr,
+                data=self._data,
                 trunk=model.name2id(TRUNK, "body"),
                 leg_actuators=np.array([model.name2id(n, "actuator") for n in legs]),
                 leg_qpos=np.array([model.jnt_qposadr[model.name2id(n, "joint")] for n in legs]),
@@ -228,6 +229,7 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
                                        "body"),
                 head_sensor=model.sensor_adr[model.name2id(
                     ARM_PREFIX + arm_lib.HEAD_VELOCITY_SENSOR, "sensor")])
+            cache["head_body"] = model.site_bodyid[cache["head_site"]]
             self.__dict__["_robot_cache"] = cache
         return cache
 
@@ -241,9 +243,9 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
 
     def head_attitude(self) -> float:
         """Head attitude (deg) in the trunk's heading plane: 0 up, 90 level, 180 down."""
-        body = self.model.site_bodyid[self._robot()["head_site"]]
-        axis = self.data.xmat[body].reshape(3, 3)[:, 2]
-        return float(np.degrees(np.arctan2(axis[:2] @ self.heading(), axis[2])))
+        xmat = self.data.xmat[self._robot()["head_body"]]  # row-major: axis z = (2, 5, 8)
+        hx, hy = self.heading()
+        return math.degrees(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8]))
 
     # Quadruped.
     def trunk_position(self) -> np.ndarray:
@@ -263,17 +265,19 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
 
     def heading(self) -> np.ndarray:
         """Unit (x, y) of the trunk's forward axis projected on the ground."""
-        forward = self.data.xmat[self._robot()["trunk"]].reshape(3, 3)[:2, 0]
-        norm = np.linalg.norm(forward)
-        return forward / norm if norm > 1e-9 else np.array([1.0, 0.0])
+        xmat = self.data.xmat[self._robot()["trunk"]]
+        fx, fy = float(xmat[0]), float(xmat[3])
+        norm = math.hypot(fx, fy)
+        return (fx / norm, fy / norm) if norm > 1e-9 else (1.0, 0.0)
 
     def to_trunk_frame(self, point, velocity: bool = False) -> np.ndarray:
         """World point (or velocity) -> (forward, left, up) in the trunk frame (module doc)."""
         hx, hy = self.heading()
-        v = np.asarray(point, float)
+        x, y, z = (float(c) for c in point)
         if not velocity:
-            v = v - np.array([*self.trunk_position()[:2], 0.0])
-        return np.array([hx * v[0] + hy * v[1], -hy * v[0] + hx * v[1], v[2]])
+            trunk = self.data.xpos[self._robot()["trunk"]]
+            x, y = x - trunk[0], y - trunk[1]
+        return np.array([hx * x + hy * y, -hy * x + hx * y, z])
 
     def from_trunk_frame(self, forward: float, up: float) -> np.ndarray:
         """(forward, up) in the trunk frame -> world point in the trunk's vertical plane."""
@@ -348,7 +352,8 @@ class _QuadrupedTaskMixin:
     Args:
       legs: ``"stand"`` or ``"walk"``.
       gait: for walking, a :class:`gait.TrotGait`, a :class:`gait.GaitReplay` or a gait
-        file path; default: replay of the shipped file.
+        file path (or any object with ``joint_targets(t, trunk_height, stride_scale)``);
+        default: replay of the shipped file.
       trunk_heights: a :class:`gait.TrunkHeightSchedule`, a callable ``random ->
         schedule`` (a new schedule each episode), or ``None`` (constant nominal height).
       steer: keep the walk on the start line (see ``STEER_*``); off = the pure open-loop gait.
@@ -399,24 +404,18 @@ class _QuadrupedTaskMixin:
     def leg_targets(self, physics) -> np.ndarray:
         t = self.episode_time(physics)
         height = float(self.height_schedule(t)) + SAG_COMPENSATION[self.legs]
-        targets = self.gait.joint_targets(t, height)
-        if self.legs == "walk" and self.steer:
-            targets = self.steer_targets(physics, targets)
-        return targets
+        scale = self.stride_scale(physics) if self.legs == "walk" and self.steer else None
+        return self.gait.joint_targets(t, height, scale)
 
-    def steer_targets(self, physics, targets) -> np.ndarray:
-        """Scale each leg's fore-aft foot travel to turn back onto the walking line."""
+    def stride_scale(self, physics) -> np.ndarray:
+        """Per-leg scale of the fore-aft foot travel that turns back onto the walking line."""
         off_line = physics.trunk_position()[1] - self._episode_start_xy[1]
-        desired = -np.clip(STEER_LINE_GAIN * off_line, -STEER_MAX_YAW, STEER_MAX_YAW)
-        heading = physics.heading()
-        error = np.arctan2(heading[1], heading[0]) - desired
-        change = np.clip(STEER_YAW_GAIN * error, -STEER_MAX_STRIDE_CHANGE, STEER_MAX_STRIDE_CHANGE)
-        scale = 1.0 + change * _LEFT_SIGN  # yawed left (error > 0): left legs step longer
-        x, z = gait_lib.leg_fk(targets[1::3], targets[2::3])
-        hip, knee = gait_lib.leg_ik(x * scale, z)
-        out = targets.copy()
-        out[1::3], out[2::3] = hip, knee
-        return out
+        desired = -min(max(STEER_LINE_GAIN * off_line, -STEER_MAX_YAW), STEER_MAX_YAW)
+        hx, hy = physics.heading()
+        error = math.atan2(hy, hx) - desired
+        change = min(max(STEER_YAW_GAIN * error, -STEER_MAX_STRIDE_CHANGE),
+                     STEER_MAX_STRIDE_CHANGE)
+        return 1.0 + change * _LEFT_SIGN  # yawed left (error > 0): left legs step longer
 
     def before_step(self, action, physics):
         action = np.asarray(action, dtype=np.float64)

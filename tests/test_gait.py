@@ -86,8 +86,24 @@ def test_replay_applies_a_new_trunk_height_by_moving_the_feet():
     lowered = replay.joint_targets(t, trunk_height=0.22)
     x0, z0 = gait.leg_fk(replay.raw_targets(t)[:, 1::3], replay.raw_targets(t)[:, 2::3])
     x1, z1 = gait.leg_fk(lowered[:, 1::3], lowered[:, 2::3])
-    np.testing.assert_allclose(x1, x0, atol=1e-9)
-    np.testing.assert_allclose(z1 - z0, replay.recorded_trunk_height - 0.22, atol=1e-9)
+    # Feet are interpolated in Cartesian space, joints in joint space: equal to ~0.1 mm.
+    np.testing.assert_allclose(x1, x0, atol=2e-4)
+    np.testing.assert_allclose(z1 - z0, replay.recorded_trunk_height - 0.22, atol=2e-4)
+    at_samples = replay.joint_targets(replay.times, trunk_height=0.22)
+    xs, zs = gait.leg_fk(at_samples[:, 1::3], at_samples[:, 2::3])
+    np.testing.assert_allclose(zs, gait.leg_fk(replay.targets[:, 1::3], replay.targets[:, 2::3])[1]
+                               + (replay.recorded_trunk_height - 0.22), atol=1e-9)
+
+
+def test_stride_scale_scales_the_fore_aft_foot_travel():
+    for source in (gait.TrotGait(), gait.GaitReplay.from_file()):
+        t = np.linspace(0, 0.4, 9)
+        plain = source.joint_targets(t, 0.27)
+        scaled = source.joint_targets(t, 0.27, stride_scale=np.array([1.2, 0.8, 1.0, 1.0]))
+        x0, z0 = gait.leg_fk(plain[:, 1::3], plain[:, 2::3])
+        x1, z1 = gait.leg_fk(scaled[:, 1::3], scaled[:, 2::3])
+        np.testing.assert_allclose(x1, x0 * [1.2, 0.8, 1.0, 1.0], atol=1e-9)
+        np.testing.assert_allclose(z1, z0, atol=1e-9)
 
 
 def _write(tmp_path, rows, header=True):
