@@ -34,6 +34,7 @@ import bisect
 import csv
 import dataclasses
 import io
+import math
 import pathlib
 
 import numpy as np
@@ -56,6 +57,8 @@ def leg_ik(foot_x, foot_z):
 
     Out-of-reach points are clamped onto the reachable annulus.
     """
+    if np.ndim(foot_x) == 1 and len(foot_x) <= 4:  # one control step: plain floats are faster
+        return _leg_ik_few(foot_x, foot_z)
     foot_x, foot_z = np.asarray(foot_x, float), np.asarray(foot_z, float)
     dist2 = foot_x ** 2 + foot_z ** 2
     cos_knee = np.clip((dist2 - L1 ** 2 - L2 ** 2) / (2 * L1 * L2), -1.0, 1.0)
@@ -65,6 +68,17 @@ def leg_ik(foot_x, foot_z):
     direction = np.arctan2(-foot_x, -foot_z)
     bend = np.arctan2(L2 * np.sin(knee), L1 + L2 * np.cos(knee))
     return direction - bend, knee
+
+
+def _leg_ik_few(foot_x, foot_z):
+    hips, knees = [], []
+    for x, z in zip(foot_x.tolist() if hasattr(foot_x, "tolist") else foot_x,
+                    foot_z.tolist() if hasattr(foot_z, "tolist") else foot_z):
+        cos_knee = min(max((x * x + z * z - L1 * L1 - L2 * L2) / (2 * L1 * L2), -1.0), 1.0)
+        knee = -math.acos(cos_knee)
+        hips.append(math.atan2(-x, -z) - math.atan2(L2 * math.sin(knee), L1 + L2 * math.cos(knee)))
+        knees.append(knee)
+    return np.array(hips), np.array(knees)
 
 
 def leg_fk(hip, knee):

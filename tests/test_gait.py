@@ -13,6 +13,10 @@ def test_leg_ik_inverts_fk_over_the_workspace():
     hip2, knee2 = gait.leg_ik(x, z)
     np.testing.assert_allclose(hip2, hip, atol=1e-9)
     np.testing.assert_allclose(knee2, knee, atol=1e-9)
+    # The per-step path (4 feet, plain floats) agrees with the vectorised one.
+    few = gait.leg_ik(x[:4], z[:4])
+    np.testing.assert_allclose(few[0], hip2[:4], atol=1e-12)
+    np.testing.assert_allclose(few[1], knee2[:4], atol=1e-12)
 
 
 def test_standing_targets_are_the_a1_standing_pose():
