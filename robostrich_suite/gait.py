@@ -1,14 +1,17 @@
 """Leg joint targets for the A1-like quadruped: an open-loop trot and gait-file replay.
 
-Both sources answer the same question, ``joint_targets(t, trunk_height)``: the
+Every source answers the same question, ``joint_targets(t, trunk_height)``: the
 12 joint targets (``quadruped.JOINT_NAMES`` order) at time ``t`` (a float or
 an array of times, vectorised) with the trunk held ``trunk_height`` above the
-ground.  The task writes them into the leg servos every control step.
+ground (a :class:`TrunkHeightSchedule` varies it during an episode).  An optional
+``stride_scale`` (4,) scales each foot's fore-aft travel, for steering.  The task
+writes the targets into the leg servos every control step.
 
 * :class:`TrotGait` -- diagonal pairs (FR+RL, FL+RR) half a cycle apart, duty
   0.5; in stance the foot moves linearly backwards by ``stride``, in swing it
   comes forward and is raised by ``lift * sin(pi u)``.  Foot positions become
   joint targets by two-link leg inverse kinematics (:func:`leg_ik`).
+* :class:`Standing` -- feet under the hips (the standing quadruped);
 * :class:`GaitReplay` -- recorded motor data (the paper replayed data from a
   real A1): samples linearly interpolated, looping.  A different trunk height
   is applied by moving every foot vertically (forward then inverse kinematics).

@@ -11,7 +11,11 @@ Tasks:
   the trunk height dips at 4-6 s and recovers at 8-10 s, as in Fig. 9A;
 * ``narrow_gap`` (Sec. 5.2.2, Fig. 10): the quadruped walks up to a wall and stops;
   the head tracks six sub-targets in order, under the wall's overhang to the bottom of
-  a narrow slot, up through it and to the final target on top.
+  a narrow slot, up through it and to the final target on top.  The obstacle: a wall
+  taller than the head can reach, standing on a horizontal shelf (0.50-0.53 m high)
+  that reaches back from it and is pierced by a 7 cm slot; below the shelf it is open.
+  The planar neck fits the slot; the head must go under the shelf and up through the
+  slot.  The arm collides with all of it (its geoms carry the arm's contact bit).
 
 The trunk frame.  Targets, head position and velocities are given in a frame that
 walks with the quadruped: origin on the ground under the trunk centre, x along the
@@ -35,7 +39,14 @@ open-loop trot with the arm mounted is stable at 2 ms (implicitfast integrator).
 Each episode starts with the quadruped standing still after ``SETTLE_TIME`` of
 physics, so the servos' sag under the robot's weight is not part of the episode.
 The legs' joint targets come from :mod:`robostrich_suite.gait` (default: replay of
-the shipped gait file ``data/a1_trot.csv``).
+the shipped gait file ``data/a1_trot.csv``), written to the leg servos in
+``before_step``; the commanded trunk height is raised by the servos' measured sag
+(``SAG_COMPENSATION``) and a small steering loop keeps the walk on its start line
+(``STEER_*``; ``steer=False`` gives the pure open-loop gait).
+
+A fallen quadruped (trunk tilted past 60 deg) or a physics divergence ends the episode.
+
+Run ``python tools/walk.py`` (:func:`main`) to see the perturbation the arm gets.
 """
 from __future__ import annotations
 
@@ -320,26 +331,13 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
 def default_target_pool() -> np.ndarray:
     """``robostrich``'s level-head training targets, in the trunk frame (module doc)."""
     from robostrich_suite import targets
-    try:
-        pool = targets.training_targets()
-    except FileNotFoundError:
-        pool = FALLBACK_FRAME_TARGETS
-    return frame_to_trunk(pool)
+    return frame_to_trunk(targets.training_targets())
 
 
 def frame_to_trunk(frame_targets) -> np.ndarray:
     """(x, z) head positions of the arm on its frame -> (forward, up) on the standing A1."""
     frame_targets = np.asarray(frame_targets, float).reshape(-1, 2)
     return frame_targets + [MOUNT_OFFSET[0], NOMINAL_MOUNT_HEIGHT - FRAME_MOUNT_HEIGHT]
-
-
-# Level-head poses of the arm on its frame (x, z), from
-# ``workspace.actuated_samples(600, seed=1)``: used only while the shared target
-# file (``targets.DATA_PATH``) is missing.
-FALLBACK_FRAME_TARGETS = np.array([
-    [0.464, 0.28], [0.435, 0.222], [0.325, 0.273], [0.161, 0.316], [0.443, 0.232],
-    [0.384, 0.292], [0.423, 0.248], [0.162, 0.32], [0.454, 0.256], [-0.206, 0.302],
-    [0.368, 0.169], [0.087, 0.587], [-0.003, 0.396], [0.385, 0.183]])
 
 
 _LEFT_SIGN = np.array([1.0 if leg.endswith("L") else -1.0 for leg in quad.LEGS])
