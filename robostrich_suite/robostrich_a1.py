@@ -162,7 +162,17 @@ def build_model(arm_spec=None, tendon_layout=None, scene: str = "flat") -> mjcf.
     frame = arena.worldbody.attach(robot)
     frame.pos = [0, 0, quad.standing_hip_height()]
     frame.add("freejoint", name="root")
+    _add_standing_keyframe(arena)
     return arena
+
+
+def _add_standing_keyframe(arena: mjcf.RootElement) -> None:
+    """Keyframe ``stand``: the standing pose with its servo targets, for plain MuJoCo users
+    of the exported XML (at ``qpos0`` the knees are outside their range)."""
+    physics = Physics.from_xml_string(arena.to_xml_string())
+    physics.place_standing()
+    arena.keyframe.add("key", name="stand", qpos=np.round(physics.data.qpos, 6),
+                       ctrl=np.round(physics.data.ctrl, 6))
 
 
 def _add_narrow_gap(arena: mjcf.RootElement) -> None:

@@ -212,6 +212,11 @@ def test_checked_in_xml_is_the_generated_model_and_loads_in_plain_mujoco():
     model = mujoco.MjModel.from_xml_path(str(path))
     assert model.nu == 21 and model.nq == 7 + 12 + 18
     assert model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE
+    # Its "stand" keyframe stands: the trunk stays at the standing height in plain MuJoCo.
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("stand").id)
+    mujoco.mj_step(model, data, 500)
+    assert data.qpos[2] == pytest.approx(quad.STANDING_TRUNK_HEIGHT, abs=0.01)
 
 
 def test_scene_name_is_checked():
