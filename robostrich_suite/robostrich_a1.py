@@ -409,6 +409,13 @@ class _QuadrupedTaskMixin:
     def trunk_height_command(self, physics) -> float:
         return float(self.height_schedule(self.episode_time(physics)))
 
+    def command_trunk_height(self, physics, height: float, ramp_time: float = 0.5) -> None:
+        """From now on, move the trunk height command linearly to ``height`` (m) over
+        ``ramp_time`` seconds and hold it (replaces the episode's schedule)."""
+        now = self.episode_time(physics)
+        self.height_schedule = gait_lib.TrunkHeightSchedule(
+            (now, now + max(ramp_time, 1e-6)), (self.trunk_height_command(physics), height))
+
     def leg_targets(self, physics) -> np.ndarray:
         t = self.episode_time(physics)
         height = float(self.height_schedule(t)) + SAG_COMPENSATION[self.legs]

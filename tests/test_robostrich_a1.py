@@ -103,6 +103,22 @@ def test_lesson4_trunk_height_changes_over_the_episode():
     assert heights[: n // 8].mean() == pytest.approx(quad.STANDING_TRUNK_HEIGHT, abs=0.01)
 
 
+def test_trunk_height_can_be_commanded_during_an_episode():
+    env = robostrich_suite.load("robostrich_a1", "head_stabilize", task_kwargs=dict(random=0))
+    env.reset()
+    for _ in range(60):
+        env.step(np.zeros(9))
+    env.task.command_trunk_height(env.physics, 0.23, ramp_time=0.4)
+    heights = []
+    for _ in range(250):
+        env.step(np.zeros(9))
+        heights.append(env.physics.trunk_height())
+    assert env.task.trunk_height_command(env.physics) == pytest.approx(0.23)
+    assert np.mean(heights[-100:]) == pytest.approx(0.23, abs=0.01)
+    with pytest.raises(ValueError, match="outside the range"):
+        env.task.command_trunk_height(env.physics, 0.05)
+
+
 def test_standing_lessons_keep_the_quadruped_in_place():
     env = robostrich_suite.load("robostrich_a1", "lesson2", task_kwargs=dict(random=0))
     env.reset()
