@@ -86,8 +86,8 @@ STEER_YAW_GAIN = 1.0  # stride change (fraction) per rad of yaw error
 STEER_LINE_GAIN = 1.5  # rad of desired yaw per m off the line
 STEER_MAX_YAW = 0.3  # rad
 STEER_MAX_STRIDE_CHANGE = 0.5  # trunk z-axis z component below this = fallen over
-ARM_PREFIX = f"{quad.MODEL_NAME}/{arm_lib.ARM_MODEL_NAME}/"
-TRUNK = f"{quad.MODEL_NAME}/{quad.TRUNK_BODY}"
+ARM_PREFIX = f"{arm_lib.ARM_MODEL_NAME}/"
+TRUNK = quad.TRUNK_BODY
 
 # Where the arm's first joint (C18) sits relative to the trunk centre, and the
 # height it has when the quadruped stands at its nominal trunk height.
@@ -133,37 +133,40 @@ SUITE = containers.TaggedTasks()
 
 # --- model ---------------------------------------------------------------------------
 def build_model(arm_spec=None, tendon_layout=None, scene: str = "flat") -> mjcf.RootElement:
-    """Arena + quadruped (free joint) + arm on the trunk; ``scene`` "flat" or "narrow_gap".
+    """Quadruped (free joint) + arm on the trunk + floor; ``scene`` "flat" or "narrow_gap".
 
     Built in the order ``dm_control.mjcf`` allows: the arm is attached to the trunk's
-    mount site of a quadruped without a free joint; the quadruped goes into the arena
-    through an attachment frame, and the free joint is added to that frame last.
+    mount site of a quadruped without a free joint, and only then is the free joint
+    added.  The quadruped is the root model and the arena (floor, light, camera,
+    obstacles) is added into it, rather than attaching the quadruped to an arena
+    through a frame: that way the arm keeps its ``arm/`` names, which the shared arm
+    accessors (``ArmPhysicsMixin``) and domain randomisation look up, instead of
+    becoming ``a1/arm/...``.
     """
     if scene not in ("flat", "narrow_gap"):
         raise ValueError(f"unknown scene {scene!r}; use 'flat' or 'narrow_gap'")
-    robot = quad.build_quadruped()
-    robot.find("site", quad.MOUNT_SITE).attach(arm_lib.build_arm(arm_spec, tendon_layout))
+    model = quad.build_quadruped()
+    model.model = "robostrich_a1"
+    model.find("site", quad.MOUNT_SITE).attach(arm_lib.build_arm(arm_spec, tendon_layout))
+    trunk = model.find("body", quad.TRUNK_BODY)
+    trunk.pos = [0, 0, quad.standing_hip_height()]
+    trunk.insert("freejoint", 0, name="root")
 
-    arena = mjcf.RootElement(model="robostrich_a1")
-    arena.compiler.angle = "radian"
-    arena.option.timestep = PHYSICS_TIMESTEP
-    arena.option.integrator = "implicitfast"
-    arena.visual.headlight.set_attributes(ambient=[0.4, 0.4, 0.4], diffuse=[0.6, 0.6, 0.6])
-    arena.asset.add("texture", name="grid", type="2d", builtin="checker", width=256, height=256,
+    model.option.timestep = PHYSICS_TIMESTEP
+    model.option.integrator = "implicitfast"
+    model.visual.headlight.set_attributes(ambient=[0.4, 0.4, 0.4], diffuse=[0.6, 0.6, 0.6])
+    model.asset.add("texture", name="grid", type="2d", builtin="checker", width=256, height=256,
                     rgb1=[0.2, 0.3, 0.4], rgb2=[0.25, 0.35, 0.45])
-    arena.asset.add("material", name="grid", texture="grid", texrepeat=[20, 20], reflectance=0.1)
-    arena.worldbody.add("light", pos=[0, -1, 3], dir=[0, 0.3, -1])
-    arena.worldbody.add("geom", name="floor", type="plane", size=[10, 10, 0.1], material="grid",
-                        friction=[1.0, 0.005, 0.0001])
-    arena.worldbody.add("camera", name="side", pos=[0.3, -2.0, 0.6], xyaxes=[1, 0, 0, 0, 0.2, 1],
+    model.asset.add("material", name="grid", texture="grid", texrepeat=[20, 20], reflectance=0.1)
+    model.worldbody.insert("light", 0, pos=[0, -1, 3], dir=[0, 0.3, -1])
+    model.worldbody.insert("geom", 1, name="floor", type="plane", size=[10, 10, 0.1],
+                           material="grid", friction=[1.0, 0.005, 0.0001])
+    model.worldbody.add("camera", name="side", pos=[0.3, -2.0, 0.6], xyaxes=[1, 0, 0, 0, 0.2, 1],
                         mode="trackcom")
     if scene == "narrow_gap":
-        _add_narrow_gap(arena)
-    frame = arena.worldbody.attach(robot)
-    frame.pos = [0, 0, quad.standing_hip_height()]
-    frame.add("freejoint", name="root")
-    _add_standing_keyframe(arena)
-    return arena
+        _add_narrow_gap(model)
+    _add_standing_keyframe(model)
+    return model
 
 
 def _add_standing_keyframe(arena: mjcf.RootElement) -> None:
@@ -217,51 +220,27 @@ def get_model_and_assets(arm_spec=None, tendon_layout=None, scene: str = "flat")
 
 # --- physics -------------------------------------------------------------------------
 class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
-    """The arm's accessors (``ArmPhysicsMixin``, arm under ``a1/arm/``) plus the quadruped's."""
-
-    def _arm_indices(self):
-        cache = self.__dict__.get("_arm_index_cache")
-        if cache is None or cache[0] is not self.model.ptr:
-            model = self.model
-            joints = [i for i in range(model.njnt)
-                      if model.id2name(i, "joint").startswith(ARM_PREFIX)
-                      and model.jnt_type[i] == 3][::-1]  # Table 1 order: atlas first
-            actuators = [i for i in range(model.nu)
-                         if model.id2name(i, "actuator").startswith(ARM_PREFIX)]
-            tendons = [int(model.actuator_trnid[i, 0]) for i in actuators]
-            cache = (model.ptr, np.array([model.jnt_qposadr[j] for j in joints]),
-                     np.array([model.jnt_dofadr[j] for j in joints]),
-                     np.array(actuators), np.array(tendons))
-            self.__dict__["_arm_index_cache"] = cache
-        return cache[1:]
+    """The arm's accessors (``ArmPhysicsMixin``) plus the quadruped's and the trunk frame."""
 
     def _robot(self):
         cache = self.__dict__.get("_robot_cache")
         if cache is None or cache["data"] is not self._data:  # a reload makes new data
             model = self.model
-            legs = [f"{quad.MODEL_NAME}/{name}" for name in quad.JOINT_NAMES]
+            legs = list(quad.JOINT_NAMES)
             cache = dict(
                 data=self._data,
                 trunk=model.name2id(TRUNK, "body"),
                 leg_actuators=np.array([model.name2id(n, "actuator") for n in legs]),
                 leg_qpos=np.array([model.jnt_qposadr[model.name2id(n, "joint")] for n in legs]),
-                head_site=model.name2id(ARM_PREFIX + arm_lib.HEAD_SITE, "site"),
-                arm_base=model.name2id(ARM_PREFIX + arm_lib.ArmSpec.from_table1().base_link,
-                                       "body"),
-                head_sensor=model.sensor_adr[model.name2id(
-                    ARM_PREFIX + arm_lib.HEAD_VELOCITY_SENSOR, "sensor")])
-            cache["head_body"] = model.site_bodyid[cache["head_site"]]
+                head_body=model.site_bodyid[model.name2id(ARM_PREFIX + arm_lib.HEAD_SITE,
+                                                          "site")],
+                # The arm's first (caudal) joint: the generator adds the chain caudal first.
+                arm_base=next(int(model.jnt_bodyid[i]) for i in range(model.njnt)
+                              if model.id2name(i, "joint").startswith(ARM_PREFIX)))
             self.__dict__["_robot_cache"] = cache
         return cache
 
-    # Arm head, world frame.
-    def head_position(self) -> np.ndarray:
-        return self.data.site_xpos[self._robot()["head_site"]].copy()
-
-    def head_velocity(self) -> np.ndarray:
-        adr = self._robot()["head_sensor"]
-        return self.data.sensordata[adr:adr + 3].copy()
-
+    # Arm head.
     def head_attitude(self) -> float:
         """Head attitude (deg) in the trunk's heading plane: 0 up, 90 level, 180 down."""
         xmat = self.data.xmat[self._robot()["head_body"]]  # row-major: axis z = (2, 5, 8)
