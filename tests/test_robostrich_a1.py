@@ -262,3 +262,19 @@ def test_walk_series_show_the_trot_and_the_scripted_nod():
     assert zero["trunk_speed"].mean() > 0.1
     # The scripted ventral pull brings the head forward of where the passive neck is.
     assert nod["head_forward_distance"][-60:].mean() > zero["head_forward_distance"][-60:].mean()
+
+
+def test_shared_arm_accessors_and_domain_randomisation_find_the_arm():
+    from robostrich_suite import randomization
+    env = robostrich_suite.load("robostrich_a1", "lesson2", task_kwargs=dict(
+        random=0, randomization=randomization.DomainRandomization(mass_scale=(1.2, 1.3))))
+    physics = env.physics
+    assert physics.arm_joint_names()[0] == "arm/atlas" and len(physics.tendon_names()) == 9
+    arm_bodies = [i for i in range(physics.model.nbody)
+                  if physics.model.id2name(i, "body").startswith("arm/")]
+    before = physics.model.body_mass.copy()
+    env.reset()
+    after = physics.model.body_mass
+    assert np.all(after[arm_bodies] > before[arm_bodies] * 1.19)
+    legs = [i for i in range(1, physics.model.nbody) if i not in arm_bodies]
+    np.testing.assert_allclose(after[legs], before[legs])  # the quadruped is not randomised
