@@ -270,9 +270,9 @@ def test_shared_arm_accessors_and_domain_randomisation_find_the_arm():
         random=0, randomization=randomization.DomainRandomization(mass_scale=(1.2, 1.3))))
     physics = env.physics
     assert physics.arm_joint_names()[0] == "arm/atlas" and len(physics.tendon_names()) == 9
-    arm_bodies = [i for i in range(physics.model.nbody)
-                  if physics.model.id2name(i, "body").startswith("arm/")]
     before = physics.model.body_mass.copy()
+    arm_bodies = [i for i in range(physics.model.nbody)  # (the attachment frame is massless)
+                  if physics.model.id2name(i, "body").startswith("arm/") and before[i] > 0]
     env.reset()
     after = physics.model.body_mass
     assert np.all(after[arm_bodies] > before[arm_bodies] * 1.19)
