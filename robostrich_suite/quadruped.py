@@ -77,7 +77,8 @@ def build_quadruped(mount_x: float = MOUNT_X) -> mjcf.RootElement:
     leg = model.default.add("default", dclass="leg")
     leg.joint.set_attributes(type="hinge", limited=True, damping=JOINT_DAMPING,
                              armature=JOINT_ARMATURE)
-    leg.geom.set_attributes(contype=1, conaffinity=1, condim=3, friction=[FOOT_FRICTION, 0.02, 0.01],
+    leg.geom.set_attributes(contype=1, conaffinity=1, condim=3,
+                            friction=[FOOT_FRICTION, 0.02, 0.01],
                             rgba=[0.25, 0.25, 0.28, 1])
     leg.position.set_attributes(kp=SERVO_KP, forcelimited=True, ctrllimited=True,
                                 forcerange=[-SERVO_FORCE_LIMIT, SERVO_FORCE_LIMIT])

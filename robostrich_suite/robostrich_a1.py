@@ -1,4 +1,4 @@
-"""Domain ``robostrich_a1``: the Robostrich arm on a walking A1-like quadruped (paper Sec. 4.2, 5.2).
+"""Domain ``robostrich_a1``: the Robostrich arm on a walking A1-like quadruped (Sec. 4.2, 5.2).
 
 Tasks:
 

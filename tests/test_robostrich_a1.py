@@ -71,7 +71,8 @@ def test_observation_values_are_in_the_trunk_frame():
     assert obs["trunk_velocity"][0] == pytest.approx(
         physics.trunk_velocity()[:2] @ heading)
     np.testing.assert_allclose(obs["joint_angles"], physics.joint_angles())
-    np.testing.assert_allclose(obs["to_target"], obs["target_position"] - obs["head_position"][[0, 2]])
+    np.testing.assert_allclose(obs["to_target"],
+                               obs["target_position"] - obs["head_position"][[0, 2]])
 
 
 def test_legs_follow_the_gait_not_the_action():
