@@ -279,3 +279,21 @@ def test_shared_arm_accessors_and_domain_randomisation_find_the_arm():
     assert np.all(after[arm_bodies] > before[arm_bodies] * 1.19)
     legs = [i for i in range(1, physics.model.nbody) if i not in arm_bodies]
     np.testing.assert_allclose(after[legs], before[legs])  # the quadruped is not randomised
+
+
+def test_trunk_frame_and_head_attitude_turn_with_the_trunk():
+    physics = a1.Physics.from_xml_string(*a1.get_model_and_assets())
+    physics.place_standing(trunk_xy=(1.0, 2.0))  # (forward() after each change below)
+    physics.forward()
+    straight = physics.to_trunk_frame(physics.head_position())
+    assert physics.head_attitude() == pytest.approx(0.0, abs=1e-6)  # straight neck: head up
+    physics.data.qpos[3:7] = [np.cos(np.pi / 4), 0, 0, np.sin(np.pi / 4)]  # yaw 90 deg
+    physics.forward()
+    np.testing.assert_allclose(physics.heading(), [0.0, 1.0], atol=1e-9)
+    np.testing.assert_allclose(physics.to_trunk_frame(physics.head_position()), straight,
+                               atol=1e-9)
+    # Bend the neck forward by 90 deg in total: level in the trunk's (now +y) heading.
+    physics.named.data.qpos[["arm/c2", "arm/c3", "arm/c4", "arm/c5", "arm/c6", "arm/c7"]] = (
+        np.radians([10, 15, 15, 20, 15, 15]))
+    physics.forward()
+    assert physics.head_attitude() == pytest.approx(90.0, abs=1e-6)
