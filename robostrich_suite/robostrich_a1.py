@@ -412,12 +412,7 @@ class _QuadrupedTaskMixin:
         return 1.0 + change * _LEFT_SIGN  # yawed left (error > 0): left legs step longer
 
     def before_step(self, action, physics):
-        action = np.asarray(action, dtype=np.float64)
-        if not np.all(np.isfinite(action)):
-            bad = np.flatnonzero(~np.isfinite(action)).tolist()
-            raise ValueError(f"action has non-finite values at indices {bad}: {action}")
-        low, high = physics.arm_control_range().T
-        physics.set_arm_control(np.clip(action, low, high))
+        physics.set_arm_control(reach.check_action(action, physics.arm_control_range()))
         physics.set_leg_targets(self.leg_targets(physics))
 
     def after_step(self, physics):
