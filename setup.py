@@ -31,6 +31,9 @@ setup(
         "gym": ["gymnasium==1.4.0"],
     },
     entry_points={
-        "console_scripts": [],
+        "console_scripts": [
+            "robostrich-walk = robostrich_suite.robostrich_a1:main",
+            "robostrich-export-xml = robostrich_suite.xml_export:main",
+        ],
     },
 )

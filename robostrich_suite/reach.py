@@ -23,6 +23,7 @@ import collections
 import numpy as np
 from dm_control.suite import base
 
+from robostrich_suite import randomization as randomization_lib
 from robostrich_suite import rewards
 
 POSITION_TOLERANCE = 0.05  # m (paper Sec. 4.2)
@@ -32,13 +33,13 @@ INITIAL_STATES = ("fixed", "continue")
 REWARDS = ("lesson1", "lesson2")
 
 
-def check_action(action: np.ndarray, physics) -> np.ndarray:
-    """Reject NaN/inf actions; clip the rest into the actuators' control range."""
+def check_action(action: np.ndarray, control_range: np.ndarray) -> np.ndarray:
+    """Reject NaN/inf actions; clip the rest into ``control_range`` ((n, 2) low/high)."""
     action = np.asarray(action, dtype=np.float64)
     if not np.all(np.isfinite(action)):
         bad = np.flatnonzero(~np.isfinite(action)).tolist()
         raise ValueError(f"action has non-finite values at indices {bad}: {action}")
-    low, high = physics.model.actuator_ctrlrange.T
+    low, high = np.asarray(control_range).T
     return np.clip(action, low, high)
 
 
@@ -50,7 +51,7 @@ class Reach(base.Task):
                  attitude_tolerance: float = ATTITUDE_TOLERANCE,
                  desired_attitude: float = DESIRED_ATTITUDE,
                  weights: rewards.RewardWeights | dict | None = None,
-                 target_axes=(0, 2), random=None):
+                 target_axes=(0, 2), randomization=None, random=None):
         """
         Args:
           reward: ``"lesson1"`` (eq. 9) or ``"lesson2"`` (eq. 10).
@@ -61,6 +62,8 @@ class Reach(base.Task):
           desired_attitude: head attitude to hold (deg; 90 = level).
           weights: lambda_1..lambda_4 (a ``RewardWeights`` or a dict of its fields).
           target_axes: world axes of the head position the targets are given in.
+          randomization: a ``DomainRandomization`` (or a dict of its fields) to draw
+            new arm parameters every episode and add joint-angle noise; None = off.
         """
         if reward not in REWARDS:
             raise ValueError(f"unknown reward {reward!r}; use one of {REWARDS}")
@@ -82,12 +85,18 @@ class Reach(base.Task):
         self.desired_attitude = float(desired_attitude)
         self.weights = weights or rewards.RewardWeights()
         self.target_axes = tuple(target_axes)
+        if isinstance(randomization, dict):
+            randomization = randomization_lib.DomainRandomization(**randomization)
+        self.randomizer = (randomization_lib.Randomizer(randomization)
+                           if randomization is not None else None)
         self.target_position = target_pool[0].copy()
         self._last_state = None
         super().__init__(random=random)
 
     # --- episode structure -------------------------------------------------
     def initialize_episode(self, physics):
+        if self.randomizer is not None:
+            self.randomizer.apply(physics, self.random)
         if self.initial_state == "continue" and self._last_state is not None:
             qpos, qvel, act = self._last_state
             with physics.reset_context():
@@ -102,7 +111,7 @@ class Reach(base.Task):
         return self.target_pool[self.random.randint(len(self.target_pool))].copy()
 
     def before_step(self, action, physics):
-        physics.set_control(check_action(action, physics))
+        physics.set_control(check_action(action, physics.model.actuator_ctrlrange))
 
     def after_step(self, physics):
         # Remember where the arm is for the next episode of a "continue" lesson.
@@ -143,7 +152,10 @@ class Reach(base.Task):
         head = self.head_xz(physics)
         obs["head_position"] = head
         obs["head_velocity"] = physics.head_velocity()[list(self.target_axes)]
-        obs["joint_angles"] = physics.joint_angles()
+        joint_angles = physics.joint_angles()
+        if self.randomizer is not None:
+            joint_angles = self.randomizer.observe_joint_angles(joint_angles, self.random)
+        obs["joint_angles"] = joint_angles
         obs["target_position"] = self.target_position.copy()
         obs["to_target"] = self.target_position - head
         attitude_error = self.attitude_error(physics)

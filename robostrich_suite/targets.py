@@ -22,6 +22,7 @@ import numpy as np
 
 DATA_PATH = pathlib.Path(__file__).parent / "data" / "level_head_poses.npz"
 HELDOUT_EVERY = 5
+MIN_TARGET_SPACING = 0.01  # m
 
 
 @functools.lru_cache(maxsize=None)
@@ -40,8 +41,23 @@ def level_head_poses() -> dict:
     return _load()
 
 
-def _split(heldout: bool) -> np.ndarray:
+def distinct_indices(positions: np.ndarray, spacing: float = MIN_TARGET_SPACING) -> np.ndarray:
+    """Indices of a greedy subset of ``positions`` whose members are >= ``spacing`` apart."""
+    kept: list[int] = []
+    for i, position in enumerate(positions):
+        if not kept or np.min(np.linalg.norm(positions[kept] - position, axis=1)) >= spacing:
+            kept.append(i)
+    return np.array(kept, dtype=int)
+
+
+@functools.lru_cache(maxsize=None)
+def _distinct_targets() -> np.ndarray:
     positions = level_head_poses()["head_position"]
+    return positions[distinct_indices(positions)]
+
+
+def _split(heldout: bool) -> np.ndarray:
+    positions = _distinct_targets()
     mask = (np.arange(len(positions)) % HELDOUT_EVERY == 0)
     return positions[mask if heldout else ~mask].copy()
 
@@ -57,8 +73,12 @@ def heldout_targets() -> np.ndarray:
 
 
 def generate(num_samples: int, seed: int = 0, path: pathlib.Path = DATA_PATH,
-             workers: int = 2) -> int:
-    """Sample the actuated workspace and save its level subset; returns its size."""
+             workers: int = 2, append: bool = False) -> int:
+    """Sample the actuated workspace and save its level subset; returns its size.
+
+    With ``append`` the new poses are added to those already in ``path`` (which
+    must come from the same arm); use another seed for new samples.
+    """
     from concurrent.futures import ProcessPoolExecutor
 
     from robostrich_suite import workspace
@@ -69,13 +89,19 @@ def generate(num_samples: int, seed: int = 0, path: pathlib.Path = DATA_PATH,
                                           for f in ("head_position", "head_attitude", "control",
                                                     "settled")))
     level = samples.level()
+    fingerprint = workspace.model_fingerprint()
+    new = dict(head_position=samples.head_position[level],
+               head_attitude=samples.head_attitude[level], control=samples.control[level])
+    if append and path.exists():
+        with np.load(path) as old:
+            if str(old["fingerprint"]) != fingerprint:
+                raise ValueError(f"{path} was made with another arm; regenerate without --append")
+            new = {key: np.concatenate([old[key], value]) for key, value in new.items()}
     path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(path, head_position=samples.head_position[level],
-                        head_attitude=samples.head_attitude[level],
-                        control=samples.control[level],
-                        fingerprint=np.array(workspace.model_fingerprint()))
+    np.savez_compressed(path, fingerprint=np.array(fingerprint), **new)
     _load.cache_clear()
-    return int(level.sum())
+    _distinct_targets.cache_clear()
+    return len(new["head_position"])
 
 
 def _sample_chunk(args):
@@ -89,8 +115,10 @@ def main(argv=None) -> None:
     parser.add_argument("--samples", type=int, default=16000)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=pathlib.Path, default=DATA_PATH)
+    parser.add_argument("--append", action="store_true",
+                        help="add to the poses already in --out (use a new --seed)")
     args = parser.parse_args(argv)
-    count = generate(args.samples, args.seed, args.out)
+    count = generate(args.samples, args.seed, args.out, append=args.append)
     print(f"wrote {count} level-head poses to {args.out}")
 
 

@@ -15,10 +15,11 @@ def test_poses_are_level_and_split_without_overlap():
     assert len(poses["head_position"]) >= 50
     assert np.all(np.abs(poses["head_attitude"] - 90) <= 5)
     train, held_out = targets.training_targets(), targets.heldout_targets()
-    assert len(train) + len(held_out) == len(poses["head_position"])
-    assert len(held_out) >= 10
+    assert len(train) >= 60 and len(held_out) >= 15
     distances = np.linalg.norm(train[:, None] - held_out[None], axis=2)
-    assert distances.min() > 0
+    assert distances.min() >= targets.MIN_TARGET_SPACING
+    for target in np.concatenate([train, held_out]):  # each one is a stored pose
+        assert np.min(np.linalg.norm(poses["head_position"] - target, axis=1)) == 0.0
 
 
 @pytest.mark.parametrize("index", [0, 7, 21])

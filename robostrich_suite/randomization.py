@@ -1,0 +1,89 @@
+"""Domain randomisation of the arm, for policies meant to survive the real robot.
+
+The paper names it as the next step towards sim-to-real (Sec. 6: randomise
+friction and damping, add noise to the joint measurements).  Each episode
+draws new scales for the arm's link masses, joint stiffness and damping and the
+tendon servo gains, always relative to the nominal model (never cumulative),
+and joint-angle observations can carry Gaussian noise.
+
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(
+        randomization=DomainRandomization(mass_scale=(0.8, 1.2))))
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from robostrich_suite import arm as arm_lib
+
+_PREFIX = arm_lib.ARM_MODEL_NAME + "/"
+
+
+@dataclasses.dataclass(frozen=True)
+class DomainRandomization:
+    """Uniform ranges of multiplicative scales; (1, 1) switches a parameter off."""
+    mass_scale: tuple[float, float] = (0.9, 1.1)
+    stiffness_scale: tuple[float, float] = (0.8, 1.2)
+    damping_scale: tuple[float, float] = (0.7, 1.3)
+    tendon_gain_scale: tuple[float, float] = (0.9, 1.1)
+    joint_angle_noise: float = 0.0  # rad, standard deviation added to observed joint angles
+
+    def __post_init__(self):
+        for field in ("mass_scale", "stiffness_scale", "damping_scale", "tendon_gain_scale"):
+            low, high = getattr(self, field)
+            if not 0 < low <= high:
+                raise ValueError(f"{field} must be (low, high) with 0 < low <= high, "
+                                 f"got {(low, high)}")
+        if self.joint_angle_noise < 0:
+            raise ValueError(f"joint_angle_noise must be >= 0, got {self.joint_angle_noise}")
+
+
+class Randomizer:
+    """Remembers the nominal model and applies fresh draws of ``DomainRandomization``."""
+
+    def __init__(self, config: DomainRandomization):
+        self.config = config
+        self._nominal = None
+
+    def _arm_ids(self, model, kind, count):
+        return np.array([i for i in range(count)
+                         if (model.id2name(i, kind) or "").startswith(_PREFIX)], dtype=int)
+
+    def _remember(self, physics):
+        model = physics.model
+        bodies = self._arm_ids(model, "body", model.nbody)
+        joints = self._arm_ids(model, "joint", model.njnt)
+        dofs = model.jnt_dofadr[joints]
+        actuators = self._arm_ids(model, "actuator", model.nu)
+        self._nominal = dict(
+            bodies=bodies, joints=joints, dofs=dofs, actuators=actuators,
+            mass=model.body_mass[bodies].copy(), inertia=model.body_inertia[bodies].copy(),
+            stiffness=model.jnt_stiffness[joints].copy(), damping=model.dof_damping[dofs].copy(),
+            gain=model.actuator_gainprm[actuators].copy(),
+            bias=model.actuator_biasprm[actuators].copy())
+
+    def apply(self, physics, random: np.random.RandomState) -> dict:
+        """Draw and set new parameters; returns the scales drawn."""
+        if self._nominal is None:
+            self._remember(physics)
+        n, c, model = self._nominal, self.config, physics.model
+        scales = dict(
+            mass=random.uniform(*c.mass_scale, size=len(n["bodies"])),
+            stiffness=random.uniform(*c.stiffness_scale, size=len(n["joints"])),
+            damping=random.uniform(*c.damping_scale, size=len(n["dofs"])),
+            tendon_gain=random.uniform(*c.tendon_gain_scale, size=len(n["actuators"])))
+        model.body_mass[n["bodies"]] = n["mass"] * scales["mass"]
+        model.body_inertia[n["bodies"]] = n["inertia"] * scales["mass"][:, None]
+        model.jnt_stiffness[n["joints"]] = n["stiffness"] * scales["stiffness"]
+        model.dof_damping[n["dofs"]] = n["damping"] * scales["damping"]
+        # Scaling gain and all bias terms together keeps the servo's rest length.
+        model.actuator_gainprm[n["actuators"]] = n["gain"] * scales["tendon_gain"][:, None]
+        model.actuator_biasprm[n["actuators"]] = n["bias"] * scales["tendon_gain"][:, None]
+        return scales
+
+    def observe_joint_angles(self, angles: np.ndarray, random: np.random.RandomState
+                             ) -> np.ndarray:
+        if self.config.joint_angle_noise == 0:
+            return angles
+        return angles + random.normal(0.0, self.config.joint_angle_noise, size=angles.shape)
