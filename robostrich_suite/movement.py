@@ -232,14 +232,23 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
 
 
 def _log_frame(recording, physics, rows, names) -> None:
+    """One frame: body poses, tendon paths, inputs, attitude and the head path so far."""
     from robostrich_suite import rerun_log
     t, control, contraction, head, attitude, _ = rows[-1]
     rerun_log.set_sim_time(recording, t)
     rerun_log.log_body_poses(recording, physics)
+    model, data = physics.model, physics.data
+    for name, tendon in zip(names, model.actuator_trnid[:, 0]):
+        start, count = data.ten_wrapadr[tendon], data.ten_wrapnum[tendon]
+        points = data.wrap_xpos[start:start + count]
+        color = (220, 50, 50) if "dorsal" in name else (40, 110, 230)
+        rerun_log.log_path(recording, f"world/tendons/{name}", points, color=color)
     rerun_log.log_scalars(recording, "tendon_input", dict(zip(names, control)))
+    rerun_log.log_scalars(recording, "tendon_contraction", dict(zip(names, contraction)))
     rerun_log.log_scalars(recording, "head", {"attitude_deg": attitude})
-    path = [[r[3][0], 0.0, r[3][1]] for r in rows]
-    rerun_log.log_path(recording, "world/head_path", path)
+    if len(rows) % 5 == 1:  # the path so far, every 0.04 s: a growing line is O(n^2) data
+        path = [[r[3][0], 0.0, r[3][1]] for r in rows]
+        rerun_log.log_path(recording, "world/head_path", path, color=(20, 20, 20))
 
 
 # --------------------------------------------------------------------------- static poses
