@@ -35,6 +35,13 @@ length, poses within 15 mm of each other differ by a median 0.6 deg of attitude.
 Any ventral sequence that moves the head the same way therefore turns it the same
 way; the caudal loop cannot widen (the lever's mark) because it is already at its
 limits.  ``tests/test_movement.py`` keeps the paper's claim as a strict xfail.
+Reproduce the 0.6 deg with ``tools/movement_tests.py --pose-family 100``.
+
+Also tried, without the difference appearing (rolling vs lever attitude range at
+equal head travel): passive joints of 5 and 20 N m/rad (``--joint-stiffness``;
+e.g. 58.7 vs 48.9 deg at 224 mm for 5 N m/rad); the dorsal tendon anchored on C10
+instead of the base (28.0 vs 24.5 deg at 185 mm); ventral tendons spanning only
+two joints each instead of running from the base (attitude ranges within 10 %).
 """
 from __future__ import annotations
 
