@@ -350,7 +350,9 @@ def plot_movement(movement: Movement, path: str | pathlib.Path, num_sticks: int 
         ax_in.plot(movement.time, 1000 * movement.contraction[:, dorsal], "--", color="tab:red",
                    lw=1, label="dorsal, measured contraction")
     ax_in.set_ylabel("tendon input (mm)")
-    ax_in.legend(fontsize=7, ncol=3, loc="upper left")
+    low, high = ax_in.get_ylim()
+    ax_in.set_ylim(low, high + 0.9 * (high - low))  # headroom for the legend
+    ax_in.legend(fontsize=7, ncol=4, loc="upper left")
     ax_in.set_title(f"(A) tendon inputs, {movement.config.pattern} pattern "
                     f"(dorsal {movement.config.dorsal_hold} held)", fontsize=10)
     ax_att.plot(movement.time, movement.head_attitude, color="k")
