@@ -32,7 +32,7 @@ setup(
     },
     entry_points={
         "console_scripts": [
-            "robostrich-walk = robostrich_suite.robostrich_a1:main",
+            "robostrich-walk = robostrich_suite.walk:main",
             "robostrich-export-xml = robostrich_suite.xml_export:main",
         ],
     },

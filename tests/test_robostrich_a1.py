@@ -6,7 +6,7 @@ from absl.testing import absltest
 from dm_env import test_utils
 
 import robostrich_suite
-from robostrich_suite import gait, quadruped as quad, robostrich_a1 as a1, xml_export
+from robostrich_suite import gait, quadruped as quad, robostrich_a1 as a1, walk, xml_export
 
 TASKS = ("lesson1", "lesson2", "lesson3", "lesson4", "head_stabilize", "narrow_gap")
 TABLE2 = {"head_position": 3, "head_velocity": 3, "joint_angles": 18, "trunk_position": 3,
@@ -250,15 +250,15 @@ def test_bad_task_options_raise():
 
 
 def test_walk_tool_writes_a_recording_and_a_plot(tmp_path, capsys):
-    a1.main(["--seconds", "0.4", "--tendons", "sine", "--out", str(tmp_path / "walk")])
+    walk.main(["--seconds", "0.4", "--tendons", "sine", "--out", str(tmp_path / "walk")])
     assert (tmp_path / "walk.rrd").stat().st_size > 10_000
     assert (tmp_path / "walk.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "mean forward speed" in capsys.readouterr().out
 
 
 def test_walk_series_show_the_trot_and_the_scripted_nod():
-    zero = a1.record_walk("lesson4", seconds=1.5, tendons="zero")
-    nod = a1.record_walk("lesson4", seconds=1.5, tendons="sine")
+    zero = walk.record_walk("lesson4", seconds=1.5, tendons="zero")
+    nod = walk.record_walk("lesson4", seconds=1.5, tendons="sine")
     assert len(zero["time"]) == round(1.5 / a1.CONTROL_TIMESTEP)
     assert zero["trunk_speed"].mean() > 0.1
     # The scripted ventral pull brings the head forward of where the passive neck is.

@@ -7,7 +7,7 @@ import os
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-from robostrich_suite.robostrich_a1 import main  # noqa: E402
+from robostrich_suite.walk import main  # noqa: E402
 
 if __name__ == "__main__":
     main()
