@@ -6,7 +6,10 @@ held at a constant contraction while the ventral tendons are ramped:
 * **rolling**: the ventral tendons are contracted one after another, caudal to
   cranial (C16 first, C2 last), so the bend travels cranially along the neck
   and the part cranial of it can stay a bar (``release=True`` lets each tendon
-  go while the next takes over; it only adds back-and-forth motion);
+  go while the next takes over; it only adds back-and-forth motion).  Caudal to
+  cranial matches the paper's description: every ventral tendon runs from the
+  base, so starting with the C2 tendon would flex the whole neck at once, which
+  is the lever;
 * **lever**: the ventral tendons are contracted simultaneously.
 
 "Held at a constant contraction" means the dorsal tendon's *length*
@@ -91,7 +94,8 @@ class MovementConfig:
 
 
 def ventral_order(physics: mjcf.Physics) -> list[int]:
-    """Actuator indices of the ventral tendons, caudal insertion first."""
+    """Actuator indices of the ventral tendons in action order, which
+    ``TendonLayout.robostrich`` lists caudal insertion first."""
     names = [physics.model.id2name(i, "actuator") for i in range(physics.model.nu)]
     return [i for i, n in enumerate(names) if "ventral" in n]
 
