@@ -34,6 +34,8 @@ setup(
         "console_scripts": [
             "robostrich-walk = robostrich_suite.walk:main",
             "robostrich-export-xml = robostrich_suite.xml_export:main",
+            "robostrich-movement = robostrich_suite.movement:main",
+            "robostrich-workspace = robostrich_suite.workspace:main",
         ],
     },
 )
