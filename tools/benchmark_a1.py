@@ -22,8 +22,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-import robostrich_suite  # noqa: E402
-from robostrich_suite import gait, quadruped, robostrich_a1  # noqa: E402
+from robostrich_suite import benchmarking, gait, quadruped, robostrich_a1  # noqa: E402
 
 
 def _raw_model():
@@ -51,30 +50,19 @@ def raw_steps_per_second(steps: int, actions: np.ndarray, with_gait: bool = Fals
     return steps / (time.perf_counter() - start)
 
 
-def env_steps_per_second(task: str, steps: int, actions: np.ndarray) -> float:
-    env = robostrich_suite.load("robostrich_a1", task, task_kwargs=dict(random=0))
-    env.reset()
-    start = time.perf_counter()
-    for i in range(steps):
-        if env.step(actions[i % len(actions)]).last():
-            env.reset()
-    return steps / (time.perf_counter() - start)
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--steps", type=int, default=2000)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--task", default="lesson4", choices=list(robostrich_a1.SUITE))
     args = parser.parse_args(argv)
-    env = robostrich_suite.load("robostrich_a1", args.task, task_kwargs=dict(random=0))
-    spec = env.action_spec()
-    actions = np.random.default_rng(0).uniform(spec.minimum, spec.maximum, size=(500, 9))
+    actions = benchmarking.random_actions("robostrich_a1", args.task)
     raw = raw_gait = wrapped = 0.0
     for _ in range(args.repeats):
         raw = max(raw, raw_steps_per_second(args.steps, actions))
         raw_gait = max(raw_gait, raw_steps_per_second(args.steps, actions, with_gait=True))
-        wrapped = max(wrapped, env_steps_per_second(args.task, args.steps, actions))
+        wrapped = max(wrapped, benchmarking.env_steps_per_second("robostrich_a1", args.task,
+                                                                 args.steps, actions))
     print(f"raw mj_step x4        : {raw:10.0f} control steps/s")
     print(f"raw + gait targets    : {raw_gait:10.0f} control steps/s")
     print(f"robostrich_a1/{args.task:8s}: {wrapped:10.0f} env steps/s "
