@@ -45,6 +45,43 @@ equal head travel): passive joints of 5 and 20 N m/rad (``--joint-stiffness``;
 e.g. 58.7 vs 48.9 deg at 224 mm for 5 N m/rad); the dorsal tendon anchored on C10
 instead of the base (28.0 vs 24.5 deg at 185 mm); ventral tendons spanning only
 two joints each instead of running from the base (attitude ranges within 10 %).
+
+Why holding the dorsal length pins the attitude: each joint lengthens the dorsal
+tendon by ``hole_offset * theta - c * theta**2`` (``c`` = a b / 2(a + b) for holes
+a and b from the joint, about a link length / 8), so with its length held the sum
+of the joint angles, which *is* the head attitude, is fixed to first order; it
+moves only through the second-order term, i.e. with how much the neck bends in
+both directions.  Checked on random joint angles: the dorsal length change over
+``hole_offset`` is the angle sum minus 0.3-0.4 rad per rad**2 of ``sum theta**2``.
+
+Travelling-wave rolling (each tendon contracted while the previous one is let go,
+so the bend moves instead of accumulating; the lever = all tendons ramped
+together), measured with a 2.5-4 s settle, 7 s of ramps (attitude range over
+head travel, start to end):
+
+    default arm, dorsal length held:  wave caudal->cranial 25.2 deg / 218 mm
+      (60 % of range), cranial->caudal 27.0 deg / 183 mm; lever 14.0 deg /
+      161 mm (50 %), 117 deg / 336 mm (100 %).  The wave follows the same
+      one-parameter family of poses as the lever (``--pose-family``): no
+      difference.
+    default arm, dorsal input held:   wave 48.8 / 180 mm and 47.5 / 177 mm;
+      lever 29.5 / 125 mm (50 %).
+    joints 5 and 20 N m/rad:          the dorsal tendon goes slack and the
+      stiff neck sways on the servos (head path 5-20x the travel); ranges
+      73-185 deg for waves and levers alike.
+    hole_fraction 0.2 or 0.8:         the static poses are still a one-parameter
+      family (attitude differs by 0.5 deg between heads within 15 mm).
+    ventral tendons spanning k joints each (built for the experiment only),
+      dorsal length held: every pattern keeps the attitude (k = 2: wave 5.7 deg /
+      61 mm, lever 6.7 deg / 409 mm); dorsal input held (the dorsal tendon's
+      servo stretch now lets the attitude follow the total ventral pull, which
+      the lever raises and the wave does not): k = 4, wave two tendons wide
+      30.0 deg / 285 mm vs lever 66.0 deg / 311 mm (ratio 0.45), but 0.46-0.61
+      for k = 3, 5 or dorsal -0.01/-0.03 m, at head travels differing up to 2x,
+      and the head swings (path 2-4x the travel).
+
+So no tried configuration gives a robust difference (rolling range below half
+the lever's at head travels within 25 %, across neighbouring settings).
 """
 from __future__ import annotations
 

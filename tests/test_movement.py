@@ -13,7 +13,10 @@ position (100 random ventral inputs: poses within 15 mm differ by a median 0.6 d
 so any ventral sequence that moves the head the same way turns it the same way.
 The paper's claim is kept below as a strict xfail: it starts failing loudly (XPASS)
 when a change to the arm makes the difference appear, and the thresholds must then
-be measured again.
+be measured again.  Travelling-wave rolling (each tendon let go as the next one
+contracts), both directions, the dorsal input held instead of its length, stiffer
+joints, other hole positions and short ventral tendons were also tried without a
+robust difference; numbers in the docstring of ``robostrich_suite.movement``.
 """
 import shutil
 import subprocess
