@@ -31,6 +31,11 @@ setup(
         "gym": ["gymnasium==1.4.0"],
     },
     entry_points={
-        "console_scripts": [],
+        "console_scripts": [
+            "robostrich-walk = robostrich_suite.walk:main",
+            "robostrich-export-xml = robostrich_suite.xml_export:main",
+            "robostrich-movement = robostrich_suite.movement:main",
+            "robostrich-workspace = robostrich_suite.workspace:main",
+        ],
     },
 )

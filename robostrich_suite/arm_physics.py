@@ -33,9 +33,14 @@ class ArmPhysicsMixin:
             actuators = [i for i in range(model.nu)
                          if model.id2name(i, "actuator").startswith(_PREFIX)]
             tendons = [int(model.actuator_trnid[i, 0]) for i in actuators]
+            head_site = model.name2id(arm_lib.HEAD_SITE_PATH, "site")
+            sensor = model.name2id(_PREFIX + arm_lib.HEAD_VELOCITY_SENSOR, "sensor")
             cache = (model.ptr, np.array([model.jnt_qposadr[j] for j in joints]),
                      np.array([model.jnt_dofadr[j] for j in joints]),
-                     np.array(actuators), np.array(tendons))
+                     np.array(actuators), np.array(tendons), head_site,
+                     int(model.site_bodyid[head_site]), int(model.sensor_adr[sensor]),
+                     -model.actuator_gainprm[actuators, 0].copy(),
+                     model.actuator_biasprm[actuators, 0].copy())
             self.__dict__["_arm_index_cache"] = cache
         return cache[1:]
 
@@ -49,15 +54,17 @@ class ArmPhysicsMixin:
 
     def head_position(self) -> np.ndarray:
         """Head site position (x, y, z) in metres, world frame."""
-        return arm_lib.head_position(self)
+        return self.data.site_xpos[self._arm_indices()[4]].copy()
 
     def head_velocity(self) -> np.ndarray:
         """Head site linear velocity (x, y, z) in m/s, world frame."""
-        return arm_lib.head_velocity(self)
+        adr = self._arm_indices()[6]
+        return self.data.sensordata[adr:adr + 3].copy()
 
     def head_attitude(self) -> float:
         """Head attitude in degrees: 90 = head parallel to the ground (paper Fig. 2B)."""
-        return arm_lib.head_attitude_deg(self)
+        xmat = self.data.xmat[self._arm_indices()[5]]  # row-major 3x3; column 2 = head axis
+        return float(np.degrees(np.arctan2(xmat[2], xmat[8])))
 
     def joint_angles(self) -> np.ndarray:
         """The 18 joint angles (rad), atlas first; positive = ventral flexion."""
@@ -72,9 +79,8 @@ class ArmPhysicsMixin:
 
     def tendon_rest_lengths(self) -> np.ndarray:
         """Length of each tendon in the straight pose (m): the servo's zero contraction."""
-        actuators = self._arm_indices()[2]
-        kp_rest = self.model.actuator_biasprm[actuators, 0]
-        return kp_rest / -self.model.actuator_gainprm[actuators, 0]
+        indices = self._arm_indices()
+        return indices[8] / indices[7]  # (kp * rest) / kp, fixed at model creation
 
     def tendon_contractions(self) -> np.ndarray:
         """How much each tendon is shorter than at rest (m)."""

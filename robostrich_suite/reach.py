@@ -33,13 +33,13 @@ INITIAL_STATES = ("fixed", "continue")
 REWARDS = ("lesson1", "lesson2")
 
 
-def check_action(action: np.ndarray, physics) -> np.ndarray:
-    """Reject NaN/inf actions; clip the rest into the actuators' control range."""
+def check_action(action: np.ndarray, control_range: np.ndarray) -> np.ndarray:
+    """Reject NaN/inf actions; clip the rest into ``control_range`` ((n, 2) low/high)."""
     action = np.asarray(action, dtype=np.float64)
     if not np.all(np.isfinite(action)):
         bad = np.flatnonzero(~np.isfinite(action)).tolist()
         raise ValueError(f"action has non-finite values at indices {bad}: {action}")
-    low, high = physics.model.actuator_ctrlrange.T
+    low, high = np.asarray(control_range).T
     return np.clip(action, low, high)
 
 
@@ -111,7 +111,7 @@ class Reach(base.Task):
         return self.target_pool[self.random.randint(len(self.target_pool))].copy()
 
     def before_step(self, action, physics):
-        physics.set_control(check_action(action, physics))
+        physics.set_control(check_action(action, physics.model.actuator_ctrlrange))
 
     def after_step(self, physics):
         # Remember where the arm is for the next episode of a "continue" lesson.

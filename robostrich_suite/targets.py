@@ -10,7 +10,7 @@ training.
 
 Regenerate after changing the default arm with::
 
-    python -m robostrich_suite.targets --samples 16000
+    python -m robostrich_suite.targets --samples 4000
 """
 from __future__ import annotations
 
@@ -23,6 +23,7 @@ import numpy as np
 DATA_PATH = pathlib.Path(__file__).parent / "data" / "level_head_poses.npz"
 HELDOUT_EVERY = 5
 MIN_TARGET_SPACING = 0.01  # m
+SEEK_LEVEL_TIME = 2.5  # s of dorsal-input tuning per draw before it is held
 
 
 @functools.lru_cache(maxsize=None)
@@ -73,21 +74,19 @@ def heldout_targets() -> np.ndarray:
 
 
 def generate(num_samples: int, seed: int = 0, path: pathlib.Path = DATA_PATH,
-             workers: int = 2, append: bool = False) -> int:
+             workers: int = 2, append: bool = False,
+             seek_level_time: float = SEEK_LEVEL_TIME) -> int:
     """Sample the actuated workspace and save its level subset; returns its size.
 
-    With ``append`` the new poses are added to those already in ``path`` (which
-    must come from the same arm); use another seed for new samples.
+    ``seek_level_time`` > 0 tunes each draw's dorsal input towards a level head
+    before holding it (:func:`robostrich_suite.workspace.seek_level`): many more
+    level poses per CPU second.  With ``append`` the new poses are added to those
+    already in ``path`` (which must come from the same arm); use another seed.
     """
-    from concurrent.futures import ProcessPoolExecutor
-
     from robostrich_suite import workspace
-    chunk = -(-num_samples // workers)
-    with ProcessPoolExecutor(workers) as pool:
-        parts = list(pool.map(_sample_chunk, [(chunk, seed + i, i == 0) for i in range(workers)]))
-    samples = workspace.ActuatedSamples(*(np.concatenate([getattr(p, f) for p in parts])
-                                          for f in ("head_position", "head_attitude", "control",
-                                                    "settled")))
+    samples = workspace.actuated_samples_parallel(num_samples, seed=seed, workers=workers,
+                                                  progress=True,
+                                                  seek_level_time=seek_level_time)
     level = samples.level()
     fingerprint = workspace.model_fingerprint()
     new = dict(head_position=samples.head_position[level],
@@ -104,21 +103,18 @@ def generate(num_samples: int, seed: int = 0, path: pathlib.Path = DATA_PATH,
     return len(new["head_position"])
 
 
-def _sample_chunk(args):
-    from robostrich_suite import workspace
-    num, seed, progress = args
-    return workspace.actuated_samples(num, seed=seed, progress=progress)
-
-
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--samples", type=int, default=16000)
+    parser.add_argument("--samples", type=int, default=4000)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=pathlib.Path, default=DATA_PATH)
+    parser.add_argument("--seek-level-time", type=float, default=SEEK_LEVEL_TIME,
+                        help="seconds of dorsal tuning towards a level head per draw (0: off)")
     parser.add_argument("--append", action="store_true",
                         help="add to the poses already in --out (use a new --seed)")
     args = parser.parse_args(argv)
-    count = generate(args.samples, args.seed, args.out, append=args.append)
+    count = generate(args.samples, args.seed, args.out, append=args.append,
+                     seek_level_time=args.seek_level_time)
     print(f"wrote {count} level-head poses to {args.out}")
 
 

@@ -22,8 +22,10 @@ def test_each_episode_draws_new_parameters_within_bounds():
         ratio = _masses(env) / _masses(nominal)
         assert np.all((ratio >= 0.5) & (ratio <= 1.5))  # relative to nominal, not cumulative
     assert len({tuple(d) for d in draws}) == 4
-    rest = env.physics.tendon_rest_lengths()  # gain scaling keeps the servo's rest length
-    np.testing.assert_allclose(rest, nominal.physics.tendon_rest_lengths(), rtol=1e-12)
+    model = env.physics.model  # gain scaling keeps each servo's rest length (bias0 / -gain0)
+    assert not np.allclose(model.actuator_gainprm[:, 0], nominal.physics.model.actuator_gainprm[:, 0])
+    np.testing.assert_allclose(model.actuator_biasprm[:, 0] / -model.actuator_gainprm[:, 0],
+                               nominal.physics.tendon_rest_lengths(), rtol=1e-12)
     floor = env.physics.named.model.body_mass["world"]
     assert floor == nominal.physics.named.model.body_mass["world"]
 

@@ -1,0 +1,508 @@
+"""The paper's movement tests (Sec. 4.3, Figs. 3-5): rolling and lever patterns.
+
+Scripted tendon inputs on the arm on its immobile frame.  The dorsal tendon is
+held at a constant contraction while the ventral tendons are ramped:
+
+* **rolling**: the ventral tendons are contracted one after another, caudal to
+  cranial (C16 first, C2 last), so the bend travels cranially along the neck
+  and the part cranial of it can stay a bar (``release=True`` lets each tendon
+  go while the next takes over; it only adds back-and-forth motion).  Caudal to
+  cranial matches the paper's description: every ventral tendon runs from the
+  base, so starting with the C2 tendon would flex the whole neck at once, which
+  is the lever;
+* **lever**: the ventral tendons are contracted simultaneously.
+
+"Held at a constant contraction" means the dorsal tendon's *length*
+(``--dorsal-hold length``, default, as in the paper: "maintaining the dorsal
+tendon length"): an integral loop on the dorsal input cancels the servo's own
+stretch (the servo is a spring of ``tendon_kp`` = 4000 N/m, so 40 N of pull
+would otherwise lengthen the tendon by 1 cm, about 40 deg of head attitude).
+``--dorsal-hold input`` holds the input instead.
+
+Both patterns start from the same pose (dorsal paid out 20 mm, the C16 tendon
+contracted, head level at 84.6 deg) and ramp the other seven ventral tendons over
+the same 7 s.  Measured with the defaults (``python tools/movement_tests.py``):
+
+    pattern  head travel  attitude (start -> end)  attitude range
+    rolling  190 mm       84.6 -> 109.4 deg        25.0 deg
+    lever    191 mm       84.6 -> 109.0 deg        25.4 deg
+
+So the model as built does **not** show the paper's difference (rolling keeping
+the attitude, lever changing it).  Why: the passive joints (1 N m/rad) are weak
+against the neck's weight, so the hanging neck rests with its caudal joints
+(C18-C11) on their ventral limits and, once the ventral tendons pull, its cranial
+joints on their dorsal limits.  A settled pose is then fixed by where along the
+neck the switch from one limit to the other happens, and the held dorsal length
+ties the attitude to it: over 100 random ventral inputs at the same dorsal
+length, poses within 15 mm of each other differ by a median 0.6 deg of attitude.
+Any ventral sequence that moves the head the same way therefore turns it the same
+way; the caudal loop cannot widen (the lever's mark) because it is already at its
+limits.  ``tests/test_movement.py`` keeps the paper's claim as a strict xfail.
+Reproduce the 0.6 deg with ``tools/movement_tests.py --pose-family 100``.
+
+Also tried, without the difference appearing (rolling vs lever attitude range at
+equal head travel): passive joints of 5 and 20 N m/rad (``--joint-stiffness``;
+e.g. 58.7 vs 48.9 deg at 224 mm for 5 N m/rad); the dorsal tendon anchored on C10
+instead of the base (28.0 vs 24.5 deg at 185 mm); ventral tendons spanning only
+two joints each instead of running from the base (attitude ranges within 10 %).
+
+Why holding the dorsal length pins the attitude: each joint lengthens the dorsal
+tendon by ``hole_offset * theta - c * theta**2`` (``c`` = a b / 2(a + b) for holes
+a and b from the joint, about a link length / 8), so with its length held the sum
+of the joint angles, which *is* the head attitude, is fixed to first order; it
+moves only through the second-order term, i.e. with how much the neck bends in
+both directions.  Checked on random joint angles: the dorsal length change over
+``hole_offset`` is the angle sum minus 0.3-0.4 rad per rad**2 of ``sum theta**2``.
+
+Travelling-wave rolling (each tendon contracted while the previous one is let go,
+so the bend moves instead of accumulating; the lever = all tendons ramped
+together), measured with a 2.5-4 s settle, 7 s of ramps (attitude range over
+head travel, start to end):
+
+    default arm, dorsal length held:  wave caudal->cranial 25.2 deg / 218 mm
+      (60 % of range), cranial->caudal 27.0 deg / 183 mm; lever 14.0 deg /
+      161 mm (50 %), 117 deg / 336 mm (100 %).  The wave follows the same
+      one-parameter family of poses as the lever (``--pose-family``): no
+      difference.
+    default arm, dorsal input held:   wave 48.8 / 180 mm and 47.5 / 177 mm;
+      lever 29.5 / 125 mm (50 %).
+    joints 5 and 20 N m/rad:          the dorsal tendon goes slack and the
+      stiff neck sways on the servos (head path 5-20x the travel); ranges
+      73-185 deg for waves and levers alike.
+    hole_fraction 0.2 or 0.8:         the static poses are still a one-parameter
+      family (attitude differs by 0.5 deg between heads within 15 mm).
+    ventral tendons spanning k joints each (built for the experiment only),
+      dorsal length held: every pattern keeps the attitude (k = 2: wave 5.7 deg /
+      61 mm, lever 6.7 deg / 409 mm); dorsal input held (the dorsal tendon's
+      servo stretch now lets the attitude follow the total ventral pull, which
+      the lever raises and the wave does not): k = 4, wave two tendons wide
+      30.0 deg / 285 mm vs lever 66.0 deg / 311 mm (ratio 0.45), but 0.46-0.61
+      for k = 3, 5 or dorsal -0.01/-0.03 m, at head travels differing up to 2x,
+      and the head swings (path 2-4x the travel).
+
+So no tried configuration gives a robust difference (rolling range below half
+the lever's at head travels within 25 %, across neighbouring settings).
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import pathlib
+import time
+
+import numpy as np
+from dm_control import mjcf
+
+from robostrich_suite import arm as arm_lib
+from robostrich_suite import workspace
+
+PATTERNS = ("rolling", "lever")
+SETTLE_TIME = 3.0  # s before the ventral ramps start: the start pose comes to rest
+RAMP_IN_TIME = 1.0  # s over which the start inputs are ramped in from the straight neck
+HOLD_TIME = 1.5  # s after the last ramp, to see the end pose at rest
+DORSAL_HOLD_GAIN = 30.0  # 1/s, integral gain of the dorsal length hold
+RECORD_EVERY = 4  # physics steps per recorded frame = the environments' 0.008 s
+
+
+@dataclasses.dataclass(frozen=True)
+class MovementConfig:
+    """Scripted inputs of one movement test (contractions in metres)."""
+    pattern: str = "rolling"
+    dorsal: float = -0.02  # dorsal contraction held throughout (negative = paid out)
+    amplitude: float = 0.05  # ventral contraction each tendon is ramped to
+    ramp_time: float = 1.0  # s per tendon (rolling); the lever ramps all over the same total
+    dorsal_hold: str = "length"  # "length": hold the tendon length; "input": hold the input
+    release: bool = False  # rolling: release each tendon while the next one contracts
+    input_noise: float = 0.0  # m, std of Gaussian noise on the ventral inputs per control step
+    seed: int = 0  # of the input noise
+
+    def validate(self, num_ventral: int) -> None:
+        if self.pattern not in PATTERNS:
+            raise ValueError(f"unknown pattern {self.pattern!r}; use one of {PATTERNS}")
+        if self.dorsal_hold not in ("length", "input"):
+            raise ValueError(f"dorsal_hold must be 'length' or 'input', got {self.dorsal_hold!r}")
+        if not self.ramp_time > 0:
+            raise ValueError(f"ramp_time must be positive, got {self.ramp_time}")
+        if num_ventral < 2:
+            raise ValueError("a movement test needs at least two ventral tendons")
+
+    def duration(self, num_ventral: int) -> float:
+        return SETTLE_TIME + (num_ventral - 1) * self.ramp_time + HOLD_TIME
+
+
+def ventral_order(physics: mjcf.Physics) -> list[int]:
+    """Actuator indices of the ventral tendons in action order, which
+    ``TendonLayout.robostrich`` lists caudal insertion first."""
+    names = [physics.model.id2name(i, "actuator") for i in range(physics.model.nu)]
+    return [i for i, n in enumerate(names) if "ventral" in n]
+
+
+def dorsal_index(physics: mjcf.Physics) -> int:
+    names = [physics.model.id2name(i, "actuator") for i in range(physics.model.nu)]
+    return next(i for i, n in enumerate(names) if n.endswith("dorsal"))
+
+
+def schedule(config: MovementConfig, physics: mjcf.Physics):
+    """``f(t) -> contraction targets`` for every tendon (dorsal: the held contraction).
+
+    Both patterns start from the same pose (dorsal at ``dorsal``, the most caudal
+    ventral tendon at ``amplitude``) and ramp the others over the same total time.
+    """
+    ventral = ventral_order(physics)
+    dorsal = dorsal_index(physics)
+    low, high = physics.model.actuator_ctrlrange.T
+    amplitude = np.clip(config.amplitude, low[ventral], high[ventral])
+    total = (len(ventral) - 1) * config.ramp_time
+
+    def targets(t: float) -> np.ndarray:
+        x = np.zeros(physics.model.nu)
+        ramp_in = min(t / RAMP_IN_TIME, 1.0)
+        x[dorsal] = ramp_in * config.dorsal
+        x[ventral[0]] = ramp_in * amplitude[0]
+        s = t - SETTLE_TIME
+        if config.pattern == "rolling":
+            for j in range(1, len(ventral)):
+                a = np.clip((s - (j - 1) * config.ramp_time) / config.ramp_time, 0.0, 1.0)
+                x[ventral[j]] = a * amplitude[j]
+                if config.release:
+                    x[ventral[j - 1]] = min(x[ventral[j - 1]], (1.0 - a) * amplitude[j - 1])
+        else:
+            a = np.clip(s / total, 0.0, 1.0)
+            x[ventral[1:]] = a * amplitude[1:]
+        return x
+
+    return targets
+
+
+@dataclasses.dataclass
+class Movement:
+    """What one movement test did, one row per recorded frame."""
+    config: MovementConfig
+    tendon_names: list[str]
+    time: np.ndarray  # (n,) s
+    control: np.ndarray  # (n, nu) actuator inputs (m)
+    contraction: np.ndarray  # (n, nu) measured tendon contractions (m)
+    head_position: np.ndarray  # (n, 2) x, z (m)
+    head_attitude: np.ndarray  # (n,) deg
+    joint_points: np.ndarray  # (n, num_joints + 1, 2): base joint ... atlas joint, head tip
+
+    @property
+    def moving(self) -> np.ndarray:
+        """Frames from the start of the ventral ramps on."""
+        return self.time >= SETTLE_TIME
+
+    def head_travel(self) -> float:
+        """Distance (m) between the head's positions at the start and the end of the ramps."""
+        path = self.head_position[self.moving]
+        return float(np.linalg.norm(path[-1] - path[0]))
+
+    def head_path_length(self) -> float:
+        path = self.head_position[self.moving]
+        return float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
+
+    def attitude_range(self) -> float:
+        """Largest minus smallest head attitude (deg, unwrapped) while the ventral tendons move."""
+        attitude = np.degrees(np.unwrap(np.radians(self.head_attitude[self.moving])))
+        return float(np.ptp(attitude))
+
+    def summary(self) -> dict:
+        return {"pattern": self.config.pattern, "head_travel_m": round(self.head_travel(), 4),
+                "head_path_m": round(self.head_path_length(), 4),
+                "attitude_range_deg": round(self.attitude_range(), 2),
+                "attitude_start_deg": round(float(self.head_attitude[self.moving][0]), 2),
+                "attitude_end_deg": round(float(self.head_attitude[-1]), 2)}
+
+
+def _chain_points(physics: mjcf.Physics, spec: arm_lib.ArmSpec) -> np.ndarray:
+    """Joint positions from the base (C18) joint to the atlas, then the head tip, as (x, z)."""
+    names = [f"{arm_lib.ARM_MODEL_NAME}/{n}" for n in reversed(spec.joint_names)]
+    points = [physics.named.data.xpos[n][[0, 2]] for n in names]
+    head = physics.named.data.xpos[names[-1]]
+    axis = arm_lib.head_axis(physics)
+    points.append((head + spec.head_length * axis)[[0, 2]])
+    return np.array(points)
+
+
+def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
+        physics: mjcf.Physics | None = None, recording=None, progress: bool = False
+        ) -> Movement:
+    """Simulate one movement test; log it to ``recording`` (a Rerun stream) if given."""
+    spec = spec or arm_lib.ArmSpec.from_table1()
+    physics = physics or workspace.frame_physics(spec)
+    ventral = ventral_order(physics)
+    config.validate(len(ventral))
+    dorsal = dorsal_index(physics)
+    model = physics.model
+    tendon_ids = model.actuator_trnid[:, 0]
+    kp = -model.actuator_gainprm[:, 0]
+    rest = model.actuator_biasprm[:, 0] / kp
+    targets = schedule(config, physics)
+    dt = model.opt.timestep
+    steps = int(round(config.duration(len(ventral)) / dt))
+    names = [model.id2name(i, "actuator").split("/")[-1] for i in range(model.nu)]
+
+    if recording is not None:
+        from robostrich_suite import rerun_log
+        rerun_log.log_geometry(recording, physics)
+
+    physics.reset()
+    rng = np.random.default_rng(config.seed)
+    noise = np.zeros(model.nu)
+    dorsal_input = 0.0
+    rows = []
+    iterator = range(steps + 1)
+    if progress:
+        from tqdm import tqdm
+        iterator = tqdm(iterator, desc=config.pattern, unit="step", mininterval=1.0)
+    for k in iterator:
+        t = k * dt
+        x = targets(t)
+        if config.input_noise > 0:
+            if k % RECORD_EVERY == 0:  # a new draw each control step (0.008 s)
+                noise[ventral] = config.input_noise * rng.standard_normal(len(ventral))
+            x = np.clip(x + noise, *model.actuator_ctrlrange.T)
+        contraction = rest - physics.data.ten_length[tendon_ids]
+        if config.dorsal_hold == "length":
+            dorsal_input += DORSAL_HOLD_GAIN * dt * (x[dorsal] - contraction[dorsal])
+            dorsal_input = float(np.clip(dorsal_input, *model.actuator_ctrlrange[dorsal]))
+            x[dorsal] = dorsal_input
+        physics.data.ctrl[:] = x
+        if k % RECORD_EVERY == 0:
+            head = workspace.head_position_xz(physics)
+            attitude = workspace.head_attitude_deg(physics)
+            rows.append((t, x.copy(), contraction, head, attitude, _chain_points(physics, spec)))
+            if recording is not None:
+                _log_frame(recording, physics, rows, names)
+        if k < steps:
+            physics.step()
+    time_, control, contraction, head, attitude, points = (np.array(c) for c in zip(*rows))
+    return Movement(config, names, time_, control, contraction, head, attitude, points)
+
+
+def _log_frame(recording, physics, rows, names) -> None:
+    """One frame: body poses, tendon paths, inputs, attitude and the head path so far."""
+    from robostrich_suite import rerun_log
+    t, control, contraction, head, attitude, _ = rows[-1]
+    rerun_log.set_sim_time(recording, t)
+    rerun_log.log_body_poses(recording, physics)
+    model, data = physics.model, physics.data
+    for name, tendon in zip(names, model.actuator_trnid[:, 0]):
+        start, count = data.ten_wrapadr[tendon], data.ten_wrapnum[tendon]
+        points = data.wrap_xpos[start:start + count]
+        color = (220, 50, 50) if "dorsal" in name else (40, 110, 230)
+        rerun_log.log_path(recording, f"world/tendons/{name}", points, color=color)
+    rerun_log.log_scalars(recording, "tendon_input", dict(zip(names, control)))
+    rerun_log.log_scalars(recording, "tendon_contraction", dict(zip(names, contraction)))
+    rerun_log.log_scalars(recording, "head", {"attitude_deg": attitude})
+    if len(rows) % 5 == 1:  # the path so far, every 0.04 s: a growing line is O(n^2) data
+        path = [[r[3][0], 0.0, r[3][1]] for r in rows]
+        rerun_log.log_path(recording, "world/head_path", path, color=(20, 20, 20))
+
+
+# --------------------------------------------------------------------------- static poses
+
+@dataclasses.dataclass
+class PoseFamily:
+    """Settled poses for random ventral inputs at one held dorsal length."""
+    dorsal: float
+    ventral_inputs: np.ndarray  # (n, num_ventral) m
+    head_position: np.ndarray  # (n, 2) m
+    head_attitude: np.ndarray  # (n,) deg
+    settled: np.ndarray  # (n,) bool
+
+    def attitude_spread(self, radius: float = 0.015) -> tuple[float, float]:
+        """Median attitude difference (deg) of settled pose pairs whose heads are closer
+        than ``radius`` m, and of pairs farther than 0.1 m apart.  A small first number
+        means the attitude is a function of the head position: no ventral sequence can
+        move the head along one path with two different attitude histories."""
+        position = self.head_position[self.settled]
+        attitude = self.head_attitude[self.settled]
+        distance = np.linalg.norm(position[:, None] - position[None], axis=2)
+        difference = np.abs(attitude[:, None] - attitude[None])
+        near = (distance < radius) & (distance > 0)
+        far = distance > 0.1
+        median = lambda mask: float(np.median(difference[mask])) if mask.any() else float("nan")
+        return median(near), median(far)
+
+
+def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int = 0,
+                spec: arm_lib.ArmSpec | None = None, settle_time: float = 3.0,
+                progress: bool = False) -> PoseFamily:
+    """Hold the dorsal length at ``dorsal`` and random ventral inputs; record where the head
+    comes to rest.  Inputs are drawn as ``u**2`` times each tendon's range (more small
+    contractions, where the head moves most), a third of them with four tendons slack."""
+    spec = spec or arm_lib.ArmSpec.from_table1()
+    physics = workspace.frame_physics(spec)
+    model = physics.model
+    ventral, dorsal_id = ventral_order(physics), dorsal_index(physics)
+    tendon_ids = model.actuator_trnid[:, 0]
+    rest = model.actuator_biasprm[:, 0] / -model.actuator_gainprm[:, 0]
+    high = model.actuator_ctrlrange[ventral, 1]
+    rng = np.random.default_rng(seed)
+    inputs = rng.uniform(size=(num_poses, len(ventral))) ** 2 * high
+    for i in range(0, num_poses, 3):
+        inputs[i, rng.choice(len(ventral), 4, replace=False)] = 0.0
+    dt = model.opt.timestep
+    positions, attitudes = np.zeros((num_poses, 2)), np.zeros(num_poses)
+    settled = np.zeros(num_poses, bool)
+    iterator = range(num_poses)
+    if progress:
+        from tqdm import tqdm
+        iterator = tqdm(iterator, desc="static poses", unit="pose")
+    for i in iterator:
+        physics.reset()
+        dorsal_input = 0.0
+        for k in range(int(round(settle_time / dt))):
+            ramp = min(k * dt / RAMP_IN_TIME, 1.0)
+            contraction = rest[dorsal_id] - physics.data.ten_length[tendon_ids[dorsal_id]]
+            dorsal_input = float(np.clip(dorsal_input + DORSAL_HOLD_GAIN * dt
+                                         * (ramp * dorsal - contraction),
+                                         *model.actuator_ctrlrange[dorsal_id]))
+            physics.data.ctrl[dorsal_id] = dorsal_input
+            physics.data.ctrl[ventral] = ramp * inputs[i]
+            physics.step()
+        settled[i] = np.abs(physics.data.qvel).max() < 0.05
+        positions[i] = workspace.head_position_xz(physics)
+        attitudes[i] = workspace.head_attitude_deg(physics)
+    return PoseFamily(dorsal, inputs, positions, attitudes, settled)
+
+
+# --------------------------------------------------------------------------- figures
+
+def plot_movement(movement: Movement, path: str | pathlib.Path, num_sticks: int = 12
+                  ) -> pathlib.Path:
+    """Figs. 4-5: (A) tendon inputs, (B) head attitude, (C) stick figures of the arm."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig = plt.figure(figsize=(13, 5.2))
+    grid = fig.add_gridspec(2, 2, width_ratios=[1.25, 1])
+    ax_in, ax_att, ax_arm = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[1, 0]), \
+        fig.add_subplot(grid[:, 1])
+    colors = plt.cm.viridis(np.linspace(0, 0.95, len(movement.tendon_names)))
+    for i, name in enumerate(movement.tendon_names):
+        style = dict(color="tab:red", lw=2.0) if "dorsal" in name else dict(color=colors[i])
+        ax_in.plot(movement.time, 1000 * movement.control[:, i], label=name, **style)
+    dorsal = movement.tendon_names.index("dorsal")
+    if movement.config.dorsal_hold == "length":
+        ax_in.plot(movement.time, 1000 * movement.contraction[:, dorsal], "--", color="tab:red",
+                   lw=1, label="dorsal, measured contraction")
+    ax_in.set_ylabel("tendon input (mm)")
+    low, high = ax_in.get_ylim()
+    ax_in.set_ylim(low, high + 0.9 * (high - low))  # headroom for the legend
+    ax_in.legend(fontsize=7, ncol=4, loc="upper left")
+    ax_in.set_title(f"(A) tendon inputs, {movement.config.pattern} pattern "
+                    f"(dorsal {movement.config.dorsal_hold} held)", fontsize=10)
+    ax_att.plot(movement.time, movement.head_attitude, color="k")
+    ax_att.axvspan(0, SETTLE_TIME, color="0.9", label="settling to the start pose")
+    summary = movement.summary()
+    ax_att.set_title(f"(B) head attitude: range {summary['attitude_range_deg']:.1f} deg, "
+                     f"head travel {1000 * summary['head_travel_m']:.0f} mm", fontsize=10)
+    ax_att.set_ylabel("attitude (deg, 90 = level)")
+    ax_att.set_xlabel("time (s)")
+    ax_att.legend(fontsize=7, loc="best")
+    for ax in (ax_in, ax_att):
+        ax.grid(alpha=0.3)
+        ax.set_xlim(movement.time[0], movement.time[-1])
+    frames = np.flatnonzero(movement.moving)
+    picks = frames[np.linspace(0, len(frames) - 1, num_sticks).astype(int)]
+    shades = plt.cm.plasma(np.linspace(0, 0.85, len(picks)))
+    for shade, frame in zip(shades, picks):
+        pts = movement.joint_points[frame]
+        ax_arm.plot(pts[:-1, 0], pts[:-1, 1], "-o", color=shade, ms=2, lw=1.2)
+        ax_arm.plot(pts[-2:, 0], pts[-2:, 1], "-", color=shade, lw=3.5)  # the head
+    ax_arm.plot(*movement.head_position[movement.moving].T, ":", color="k", lw=1,
+                label="head path")
+    ax_arm.plot(*movement.joint_points[0, 0], "ks", ms=7, label="C18-frame joint")
+    ax_arm.set_aspect("equal")
+    ax_arm.set_xlabel("x (m, forward)")
+    ax_arm.set_ylabel("z (m, up)")
+    ax_arm.grid(alpha=0.3)
+    ax_arm.legend(fontsize=8, loc="lower left")
+    ax_arm.set_title("(C) trajectory (early: purple, late: yellow); thick = head", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+# --------------------------------------------------------------------------- command line
+
+def main(argv=None) -> dict:
+    """Command line: run both patterns, write a PNG and a Rerun recording of each."""
+    parser = argparse.ArgumentParser(
+        prog="robostrich-movement",
+        description="The paper's movement tests (Sec. 4.3, Figs. 4-5): rolling and lever "
+                    "patterns of the ventral tendons while the dorsal tendon is held. Writes "
+                    "{pattern}.png (tendon inputs, head attitude, stick figures) and "
+                    "{pattern}.rrd (open with `rerun FILE`).")
+    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/movement"),
+                        help="output directory (default: %(default)s)")
+    parser.add_argument("--patterns", nargs="+", choices=PATTERNS, default=list(PATTERNS))
+    defaults = MovementConfig()
+    parser.add_argument("--dorsal", type=float, default=defaults.dorsal,
+                        help="dorsal contraction held throughout, m (default: %(default)s)")
+    parser.add_argument("--amplitude", type=float, default=defaults.amplitude,
+                        help="ventral contraction per tendon, m (default: %(default)s)")
+    parser.add_argument("--ramp-time", type=float, default=defaults.ramp_time,
+                        help="seconds per ventral tendon (default: %(default)s)")
+    parser.add_argument("--dorsal-hold", choices=("length", "input"),
+                        default=defaults.dorsal_hold,
+                        help="hold the dorsal tendon's length or its input (default: %(default)s)")
+    parser.add_argument("--joint-stiffness", type=float, default=None,
+                        help="override the passive joint stiffness, N m/rad (default: the arm's)")
+    parser.add_argument("--input-noise", type=float, default=0.0,
+                        help="std (m) of Gaussian noise added to the ventral inputs every "
+                             "control step, to see how robust a pattern is (default: %(default)s)")
+    parser.add_argument("--seed", type=int, default=0,
+                        help="seed of the input noise; without noise the tests are "
+                             "deterministic (default: %(default)s)")
+    parser.add_argument("--pose-family", type=int, default=0, metavar="N",
+                        help="also settle N random ventral inputs at the held dorsal length and "
+                             "print how tightly the attitude follows the head position "
+                             "(about 0.1 s each; default: %(default)s)")
+    parser.add_argument("--no-recording", action="store_true", help="skip the .rrd files")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    args = parser.parse_args(argv)
+
+    overrides = {} if args.joint_stiffness is None else {"joint_stiffness": args.joint_stiffness}
+    spec = arm_lib.ArmSpec.from_table1(**overrides)
+    written, results = [], {}
+    start = time.perf_counter()
+    for pattern in args.patterns:
+        config = MovementConfig(pattern, args.dorsal, args.amplitude, args.ramp_time,
+                                args.dorsal_hold, input_noise=args.input_noise, seed=args.seed)
+        recording = None
+        rrd = args.out / f"{pattern}.rrd"
+        if not args.no_recording:
+            from robostrich_suite import rerun_log
+            recording = rerun_log.recording(f"robostrich_movement_{pattern}", rrd)
+        movement = run(config, spec, recording=recording, progress=not args.no_progress)
+        if recording is not None:
+            recording.flush()
+            written.append(rrd)
+        written.append(plot_movement(movement, args.out / f"{pattern}.png"))
+        results[pattern] = movement
+        s = movement.summary()
+        print(f"{pattern:8s} head travel {1000 * s['head_travel_m']:6.1f} mm "
+              f"(path {1000 * s['head_path_m']:.0f} mm), attitude "
+              f"{s['attitude_start_deg']:.1f} -> {s['attitude_end_deg']:.1f} deg, "
+              f"range {s['attitude_range_deg']:.1f} deg")
+    if args.pose_family > 0:
+        family = pose_family(args.pose_family, args.dorsal, args.seed, spec,
+                             progress=not args.no_progress)
+        near, far = family.attitude_spread()
+        print(f"static poses at dorsal {args.dorsal} m: {family.settled.sum()} of "
+              f"{args.pose_family} settled; attitude differs by a median {near:.1f} deg between "
+              f"heads within 15 mm, {far:.1f} deg between heads over 100 mm apart")
+    for path in written:
+        print(f"wrote {path}")
+    print(f"done in {time.perf_counter() - start:.1f} s")
+    return results
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,163 @@
+"""The walk tool: the quadruped's gait with scripted tendons, as a recording and a figure.
+
+    robostrich-walk [--task head_stabilize] [--tendons zero|sine] [--gait trot|FILE] --out out/walk
+
+writes ``out/walk.rrd`` (the robot over sim time, the head's path, the series
+below as scalars) and ``out/walk.png`` (trunk and head height, speeds, the head's
+distance ahead of the trunk, head attitude and trunk pitch over time), so a user
+sees the perturbation the arm gets from walking.
+"""
+from __future__ import annotations
+
+import argparse
+import collections
+import pathlib
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+import robostrich_suite  # noqa: E402
+from robostrich_suite import gait as gait_lib  # noqa: E402
+from robostrich_suite import rerun_log  # noqa: E402
+from robostrich_suite.robostrich_a1 import CONTROL_TIMESTEP, SUITE  # noqa: E402
+
+
+def scripted_tendons(kind: str, control_range: np.ndarray):
+    """Tendon input as a function of time: ``zero``, or ``sine`` (a slow nod: the ventral
+    tendons contract together at 0.5 Hz up to 30 % of their range, the dorsal one pays out)."""
+    low, high = control_range.T
+    if kind == "zero":
+        return lambda t: np.zeros(len(low))
+    if kind == "sine":
+        def nod(t):
+            level = 0.15 * (1 - np.cos(2 * np.pi * 0.5 * t))
+            action = level * high
+            action[0] = level * low[0]
+            return action
+        return nod
+    raise ValueError(f"unknown tendon script {kind!r}; use 'zero' or 'sine'")
+
+
+def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendons: str = "zero",
+                gait=None, rrd_path=None, seed: int = 0) -> dict:
+    """Run ``task_name`` with scripted tendons; returns the time series (and writes an .rrd).
+
+    Series: ``time``, ``trunk_height``, ``height_command``, ``head_height``,
+    ``trunk_speed`` (forward), ``head_speed`` (3-D), ``head_vertical_speed``,
+    ``head_forward_distance`` (from the trunk centre), ``head_attitude``, ``trunk_pitch``.
+    """
+    task_kwargs = dict(random=seed, time_limit=seconds)
+    if gait is not None:
+        task_kwargs["gait"] = gait
+    env = robostrich_suite.load("robostrich_a1", task_name, task_kwargs=task_kwargs)
+    env.reset()
+    physics = env.physics
+    script = scripted_tendons(tendons, physics.arm_control_range())
+    rec = None
+    if rrd_path is not None:
+        rec = rerun_log.recording("robostrich_a1_walk", pathlib.Path(rrd_path))
+        rerun_log.log_geometry(rec, physics)
+    series = collections.defaultdict(list)
+    head_path = []
+    steps = int(round(seconds / CONTROL_TIMESTEP))
+    for i in range(steps):
+        t = env.task.episode_time(physics)
+        step = env.step(script(t))
+        t = env.task.episode_time(physics)
+        head = physics.head_position()
+        head_velocity = physics.head_velocity()
+        trunk_axis_x = physics.data.xmat[physics._robot()["trunk"]].reshape(3, 3)[:, 0]
+        values = dict(
+            time=t, trunk_height=physics.trunk_height(),
+            height_command=env.task.trunk_height_command(physics), head_height=head[2],
+            trunk_speed=physics.to_trunk_frame(physics.trunk_velocity(), velocity=True)[0],
+            head_speed=float(np.linalg.norm(head_velocity)),
+            head_vertical_speed=head_velocity[2],
+            head_forward_distance=physics.to_trunk_frame(head)[0],
+            head_attitude=physics.head_attitude(),
+            trunk_pitch=float(np.degrees(np.arcsin(np.clip(-trunk_axis_x[2], -1, 1)))))
+        for key, value in values.items():
+            series[key].append(float(value))
+        if rec is not None:
+            head_path.append(head)
+            rerun_log.set_sim_time(rec, t)
+            rerun_log.log_body_poses(rec, physics)
+            rerun_log.log_scalars(rec, "plots", {k: v for k, v in values.items() if k != "time"})
+            if i % 10 == 0:
+                rerun_log.log_path(rec, "world/head_path", head_path)
+        if step.last():
+            break
+    if rec is not None:
+        rec.flush()
+    return {key: np.array(value) for key, value in series.items()}
+
+
+def plot_walk(series: dict, path, title: str = "") -> None:
+    """PNG of trunk and head height, speed and attitude over time."""
+    t = series["time"]
+    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
+    axes[0].plot(t, series["head_height"], label="head height")
+    axes[0].plot(t, series["trunk_height"], label="trunk height")
+    axes[0].plot(t, series["height_command"], "--", label="trunk height command")
+    axes[0].set_ylabel("height above ground (m)")
+    axes[1].plot(t, series["trunk_speed"], label="trunk forward speed")
+    axes[1].plot(t, series["head_speed"], label="head speed (3-D)", alpha=0.8)
+    axes[1].plot(t, series["head_vertical_speed"], label="head vertical speed", alpha=0.8)
+    axes[1].set_ylabel("speed (m/s)")
+    axes[2].plot(t, series["head_forward_distance"], label="head ahead of trunk centre (P_d)")
+    axes[2].set_ylabel("distance (m)")
+    axes[3].plot(t, series["head_attitude"], label="head attitude (90 = level)")
+    axes[3].plot(t, series["trunk_pitch"], label="trunk pitch (nose down +)")
+    axes[3].set_ylabel("angle (deg)")
+    axes[3].set_xlabel("time (s)")
+    for axis in axes:
+        axis.grid(alpha=0.3)
+        axis.legend(loc="upper right", fontsize=8)
+    if title:
+        axes[0].set_title(title)
+    fig.tight_layout()
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def main(argv=None) -> None:
+    """The walk tool: trot with scripted tendons, write a Rerun recording and a PNG."""
+    parser = argparse.ArgumentParser(
+        description="Walk the quadruped with the arm on it; write out/walk.rrd and out/walk.png "
+                    "(trunk and head height, speed and attitude over time).")
+    parser.add_argument("--task", default="head_stabilize", choices=list(SUITE),
+                        help="robostrich_a1 task whose gait and trunk heights to run")
+    parser.add_argument("--seconds", type=float, default=12.0)
+    parser.add_argument("--tendons", default="zero", choices=["zero", "sine"],
+                        help="scripted tendon input (zero: the passive neck)")
+    parser.add_argument("--gait", default=None,
+                        help="gait file (CSV, see robostrich_suite.gait) or 'trot' for the "
+                             "generator; default: the shipped file")
+    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/walk"),
+                        help="output path without suffix: writes OUT.rrd and OUT.png")
+    parser.add_argument("--no-rrd", action="store_true", help="skip the Rerun recording")
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    gait = gait_lib.TrotGait() if args.gait == "trot" else args.gait
+    rrd = None if args.no_rrd else args.out.with_suffix(".rrd")
+    series = record_walk(args.task, args.seconds, args.tendons, gait, rrd, args.seed)
+    png = args.out.with_suffix(".png")
+    plot_walk(series, png, f"robostrich_a1/{args.task}, tendons: {args.tendons}")
+    walked = np.sum(series["trunk_speed"]) * CONTROL_TIMESTEP
+    print(f"{len(series['time'])} steps, {series['time'][-1]:.2f} s: "
+          f"mean forward speed {walked / series['time'][-1]:.3f} m/s, "
+          f"head height {series['head_height'].mean():.3f} +- {series['head_height'].std():.3f} m, "
+          f"head attitude {series['head_attitude'].mean():.1f} +- "
+          f"{series['head_attitude'].std():.1f} deg")
+    if rrd is not None:
+        print(f"wrote {rrd}")
+    print(f"wrote {png}")
+
+
+if __name__ == "__main__":
+    main()

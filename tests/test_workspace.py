@@ -1,0 +1,118 @@
+"""Kinematic and actuated workspace (paper Fig. 6 and beyond), from real MuJoCo runs."""
+import numpy as np
+import pytest
+
+from robostrich_suite import arm, targets, workspace
+
+
+@pytest.fixture(scope="module")
+def physics():
+    return workspace.frame_physics()
+
+
+@pytest.fixture(scope="module")
+def kinematic(physics):
+    # 3000 uniform + 3000 edge samples: ~0.1 s of forward kinematics per thousand.
+    return workspace.kinematic_samples(3000, seed=1, physics=physics, num_edge=3000)
+
+
+@pytest.fixture(scope="module")
+def actuated(physics):
+    return workspace.actuated_samples(16, seed=3, physics=physics)
+
+
+def test_head_stays_within_the_sum_of_link_lengths(kinematic, physics):
+    base = workspace.base_joint_xz(physics)
+    distance = np.linalg.norm(kinematic.head_position - base, axis=1)
+    spec = arm.ArmSpec.from_table1()
+    # Table 1's lengths sum to 611.4 mm; the head site sits half a head length further.
+    assert workspace.reach_radius() == pytest.approx(0.6114 + spec.head_site_fraction
+                                                     * spec.head_length)
+    assert distance.max() <= workspace.reach_radius() + 1e-9
+    # ... and the sample really spreads out: from curled up to nearly straight.
+    assert distance.min() < 0.25 and distance.max() > 0.6
+
+
+def test_joint_angles_are_within_table1_limits(kinematic):
+    limits = arm.ArmSpec.from_table1().joint_range_rad()
+    assert np.all(kinematic.joint_angles >= limits[:, 0])
+    assert np.all(kinematic.joint_angles <= limits[:, 1])
+    assert kinematic.uniform.sum() == 3000
+
+
+def test_attitude_is_the_sum_of_joint_angles(kinematic):
+    """A planar chain: MuJoCo's head attitude equals the summed joint angles (mod 360)."""
+    summed = np.degrees(kinematic.joint_angles.sum(axis=1))
+    difference = (kinematic.head_attitude - summed + 180) % 360 - 180
+    np.testing.assert_allclose(difference, 0, atol=1e-6)
+
+
+def test_blue_set_is_a_level_subset_of_the_red_set(kinematic):
+    level = kinematic.level()
+    assert 0 < level.sum() < len(level)
+    blue = kinematic.head_position[level]
+    red = {tuple(p) for p in kinematic.head_position}
+    assert all(tuple(p) in red for p in blue)
+    assert np.all(np.abs(kinematic.head_attitude[level] - 90) <= 5)
+    assert np.all(np.abs(kinematic.head_attitude[~level] - 90) > 5)
+
+
+def test_actuated_poses_lie_in_the_kinematic_workspace(actuated, physics):
+    """Settled poses stay within Table 1's limits up to LIMIT_TOLERANCE_DEG (soft limits;
+    measured worst case 0.8 deg over 1200 random inputs), so clamping them onto the
+    limits moves the head by at most a few millimetres."""
+    assert actuated.settled.sum() >= 10
+    spec = arm.ArmSpec.from_table1()
+    limits = spec.joint_range_rad()
+    tolerance = np.radians(workspace.LIMIT_TOLERANCE_DEG)
+    angles = actuated.joint_angles[actuated.settled]
+    assert np.all(angles >= limits[:, 0] - tolerance)
+    assert np.all(angles <= limits[:, 1] + tolerance)
+    clamped = np.clip(angles, limits[:, 0], limits[:, 1])
+    qpos_adr = physics.model.jnt_qposadr[workspace._arm_joint_ids(physics, spec)]
+    for pose, head in zip(clamped, actuated.head_position[actuated.settled]):
+        with physics.reset_context():
+            physics.data.qpos[qpos_adr] = pose
+        assert np.linalg.norm(workspace.head_position_xz(physics) - head) < 0.01
+    base = workspace.base_joint_xz(physics)
+    distance = np.linalg.norm(actuated.head_position - base, axis=1)
+    assert distance.max() <= workspace.reach_radius() + 1e-9
+
+
+def test_actuated_workspace_reaches_less_than_the_kinematic_one(actuated, kinematic, physics):
+    """Under gravity the neck hangs forward: no settled pose curls far back."""
+    x = actuated.head_position[actuated.settled, 0]
+    assert x.min() > kinematic.head_position[:, 0].min() + 0.1
+
+
+def test_level_seeking_finds_inputs_that_hold_the_head_level(physics):
+    samples = workspace.actuated_samples(6, seed=2, physics=physics, seek_level_time=2.5)
+    level = samples.level()
+    assert level.sum() >= 2  # measured 42 % of draws (3.5 % without seeking)
+    for control, head in zip(samples.control[level], samples.head_position[level]):
+        assert workspace.settle(physics, control)  # the stored inputs alone, from reset
+        np.testing.assert_allclose(workspace.head_position_xz(physics), head, atol=1e-9)
+        assert abs(workspace.head_attitude_deg(physics) - 90) <= 5
+
+
+def test_command_line_writes_the_figure_and_the_samples(tmp_path):
+    out = tmp_path / "ws"
+    written = workspace.main(["--out", str(out), "--samples", "2000", "--edge-samples", "2000",
+                              "--actuated-samples", "4", "--workers", "1", "--settle-time",
+                              "0.5", "--no-progress"])
+    png = written["figure"]
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+    with np.load(written["samples"]) as data:
+        assert data["kinematic_head_position"].shape == (4000, 2)
+        assert data["actuated_head_position"].shape == (4, 2)
+        assert data["kinematic_level"].dtype == bool
+        assert str(data["fingerprint"]) == workspace.model_fingerprint()
+
+
+def test_targets_are_generated_from_the_workspace_sampler(tmp_path):
+    """targets.generate still draws from workspace.actuated_samples (the one source)."""
+    path = tmp_path / "poses.npz"
+    count = targets.generate(4, seed=5, path=path, workers=1)
+    with np.load(path) as data:
+        assert len(data["head_position"]) == count
+        assert np.all(np.abs(data["head_attitude"] - 90) <= 5)

@@ -1,0 +1,75 @@
+"""Environment speed: `robostrich_a1` lesson4 steps/s against raw mj_step of the same model.
+
+    python tools/benchmark_a1.py [--steps 3000] [--task lesson4]
+
+All runs use the same MJCF and the same 4 physics substeps per control step:
+
+* raw: ``mujoco.mj_step`` with the tendon inputs and a standing pose written to ``ctrl``;
+* raw + gait: as raw, plus the gait's 12 joint targets computed in numpy each step;
+* env: ``robostrich_suite.load("robostrich_a1", task).step`` (gait, steering, checks,
+  observation and reward).
+
+The printed ratios are the cost of the wrapper (env/raw) and of the gait alone.  The
+CPU is shared, so the three are run interleaved ``--repeats`` times and the best
+rate of each is kept.
+"""
+import argparse
+import os
+import time
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+
+from robostrich_suite import benchmarking, gait, quadruped, robostrich_a1  # noqa: E402
+
+
+def _raw_model():
+    model = mujoco.MjModel.from_xml_string(robostrich_a1.get_model_and_assets()[0])
+    data = mujoco.MjData(model)
+    physics = robostrich_a1.Physics.from_xml_string(robostrich_a1.get_model_and_assets()[0])
+    physics.place_standing()
+    data.qpos[:] = physics.data.qpos
+    arm = physics._arm_indices()[2]
+    legs = physics._robot()["leg_actuators"]
+    return model, data, arm, legs
+
+
+def raw_steps_per_second(steps: int, actions: np.ndarray, with_gait: bool = False) -> float:
+    model, data, arm, legs = _raw_model()
+    substeps = int(round(robostrich_a1.CONTROL_TIMESTEP / model.opt.timestep))
+    source = gait.GaitReplay.from_file()
+    data.ctrl[legs] = quadruped.STANDING_TARGETS
+    start = time.perf_counter()
+    for i in range(steps):
+        data.ctrl[arm] = actions[i % len(actions)]
+        if with_gait:
+            data.ctrl[legs] = source.joint_targets(data.time, 0.28)
+        mujoco.mj_step(model, data, substeps)
+    return steps / (time.perf_counter() - start)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--steps", type=int, default=2000)
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--task", default="lesson4", choices=list(robostrich_a1.SUITE))
+    args = parser.parse_args(argv)
+    actions = benchmarking.random_actions("robostrich_a1", args.task)
+    raw = raw_gait = wrapped = 0.0
+    for _ in range(args.repeats):
+        raw = max(raw, raw_steps_per_second(args.steps, actions))
+        raw_gait = max(raw_gait, raw_steps_per_second(args.steps, actions, with_gait=True))
+        wrapped = max(wrapped, benchmarking.env_steps_per_second("robostrich_a1", args.task,
+                                                                 args.steps, actions))
+    print(f"raw mj_step x4        : {raw:10.0f} control steps/s")
+    print(f"raw + gait targets    : {raw_gait:10.0f} control steps/s")
+    print(f"robostrich_a1/{args.task:8s}: {wrapped:10.0f} env steps/s "
+          f"(including resets every {robostrich_a1.LESSON4_TIME_LIMIT:g} s)")
+    print(f"ratio env/raw         : {wrapped / raw:10.3f}")
+    print(f"ratio (raw+gait)/raw  : {raw_gait / raw:10.3f}")
+
+
+if __name__ == "__main__":
+    main()
