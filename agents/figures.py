@@ -26,19 +26,22 @@ def plot_learning_curves(runs: Dict[str, List[dict]], evals: Dict[str, List[dict
                          lesson_boundaries=None):
     """Fig. 7b: training return and success per episode, and held-out position error, curriculum vs SAC."""
     fig, axes = plt.subplots(1, 3, figsize=(15, 4))
+    labels = list(dict.fromkeys(list(runs) + list(evals or {})))
+    color = {label: f"C{i}" for i, label in enumerate(labels)}
     for label, records in runs.items():
         if not records:
             continue
         steps = [r["env_steps"] for r in records]
         w = max(1, len(records) // 50)
-        axes[0].plot(steps, _smooth([r["return"] for r in records], w), label=label)
-        axes[1].plot(steps, _smooth([float(r["success"]) for r in records], w), label=label)
+        axes[0].plot(steps, _smooth([r["return"] for r in records], w), color=color[label], label=label)
+        axes[1].plot(steps, _smooth([float(r["success"]) for r in records], w), color=color[label], label=label)
     for label, records in (evals or {}).items():
         if records:
-            axes[2].plot([r["env_steps"] for r in records],
-                         [r["summary"]["position_error_median"] for r in records], "o-", label=f"{label} median")
-            axes[2].plot([r["env_steps"] for r in records],
-                         [r["summary"]["position_error_p90"] for r in records], "x--", label=f"{label} p90")
+            steps = [r["env_steps"] for r in records]
+            axes[2].plot(steps, [r["summary"]["position_error_median"] for r in records], "o-", color=color[label],
+                         label=f"{label} median")
+            axes[2].plot(steps, [r["summary"]["position_error_p90"] for r in records], "x--", color=color[label],
+                         label=f"{label} p90")
     axes[2].axhline(probes.POSITION_TOLERANCE, color="k", lw=0.8, ls=":")
     for ax in axes:
         for b in lesson_boundaries or []:
