@@ -15,7 +15,7 @@ from agents.sac.config import SACConfig  # noqa: E402
 # Small but real: lesson 1 (eq. 9, position only) on the default arm and target set.
 CONFIG = SACConfig(batch_size=64, hidden_sizes=(64, 64), learning_rate=1e-3, init_temperature=0.1,
                    min_replay_size=1000, max_replay_size=20_000, updates_per_call=4, env_steps_per_call=4)
-STEPS = 16_000
+STEPS = 24_000  # measured here: success 0 -> 5/27 held-out targets, median error 0.43 -> 0.11 m
 
 
 def position_report(run):
