@@ -32,6 +32,8 @@ setup(
     },
     entry_points={
         "console_scripts": [
+            "robostrich-train = agents.training:main",
+            "robostrich-evaluate = agents.evaluation:main",
             "robostrich-walk = robostrich_suite.walk:main",
             "robostrich-export-xml = robostrich_suite.xml_export:main",
             "robostrich-movement = robostrich_suite.movement:main",
