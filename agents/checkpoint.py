@@ -32,6 +32,7 @@ def save(path: str, payload: dict, fingerprint: dict) -> None:
             f.write(body)
             f.flush()
             os.fsync(f.fileno())
+        os.chmod(tmp, 0o644)  # mkstemp makes it private; a checkpoint is an ordinary output file
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
