@@ -47,6 +47,7 @@ def plot_learning_curves(runs: Dict[str, List[dict]], evals: Dict[str, List[dict
         for b in lesson_boundaries or []:
             ax.axvline(b, color="grey", lw=0.6, ls="--")
         ax.set_xlabel("environment steps")
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(3, 3))  # "x10^3": no overlapping labels
         ax.legend(fontsize=8)
     axes[0].set_ylabel("episode return (training)")
     axes[1].set_ylabel("success rate (training episodes)")
