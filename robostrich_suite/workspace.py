@@ -82,8 +82,7 @@ def base_joint_xz(physics: mjcf.Physics, spec: arm_lib.ArmSpec | None = None) ->
 
 def reach_radius(spec: arm_lib.ArmSpec | None = None) -> float:
     """Farthest the head site can be from the base joint: all links straight plus the head."""
-    spec = spec or arm_lib.ArmSpec.from_table1()
-    return float(sum(spec.link_lengths) + spec.head_site_fraction * spec.head_length)
+    return arm_lib.reach(spec or arm_lib.ArmSpec.from_table1())
 
 
 # --------------------------------------------------------------------------- kinematic
