@@ -5,9 +5,9 @@ of the desired attitude (90 deg = level) at the end of an episode.
 """
 import numpy as np
 
-POSITION_TOLERANCE = 0.05  # m
-ATTITUDE_TOLERANCE = 5.0  # deg
-LEVEL_ATTITUDE = 90.0  # deg
+# The paper's tolerances and desired attitude, defined once by the tasks.
+from robostrich_suite.reach import ATTITUDE_TOLERANCE, POSITION_TOLERANCE  # noqa: F401
+from robostrich_suite.reach import DESIRED_ATTITUDE as LEVEL_ATTITUDE  # noqa: F401
 
 
 def head_errors(env):
