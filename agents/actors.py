@@ -4,7 +4,6 @@ The policy network works in [-1, 1]^|A|; `ActionAdapter` maps that box onto
 the BoundedArray spec (e.g. tendon contractions in metres) and back.
 """
 import jax
-import jax.numpy as jnp
 import numpy as np
 
 from agents.sac.networks import SACNetworks

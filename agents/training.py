@@ -21,7 +21,7 @@ from collections import deque
 import numpy as np
 
 from agents import evaluation
-from agents.curriculum import (ROBOSTRICH_DOMAINS, CurriculumRun, Lesson, TrainingInterrupted, format_plan,
+from agents.curriculum import (ROBOSTRICH_DOMAINS, CurriculumRun, Lesson, format_plan,
                                parse_plan)
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig

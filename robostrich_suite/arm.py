@@ -28,8 +28,6 @@ naming the offending item.
 from __future__ import annotations
 
 import dataclasses
-import math
-from typing import Sequence
 
 import numpy as np
 from dm_control import mjcf

@@ -90,8 +90,20 @@ class ArmPhysicsMixin:
         """Pull in each tendon (N, >= 0), in action order."""
         return -self.data.actuator_force[self._arm_indices()[2]].copy()
 
+    def tendon_max_forces(self) -> np.ndarray:
+        """Largest pull of each tendon's actuator (N, > 0), in action order."""
+        return -self.model.actuator_forcerange[self._arm_indices()[2], 0]
+
     def arm_control(self) -> np.ndarray:
         return self.data.ctrl[self._arm_indices()[2]].copy()
+
+    def arm_control_range(self) -> np.ndarray:
+        """(9, 2) low/high tendon contractions (m): the action spec's bounds."""
+        return self.model.actuator_ctrlrange[self._arm_indices()[2]]
+
+    def set_arm_control(self, action) -> None:
+        """Write tendon contractions to the arm's actuators only (a robot may have others)."""
+        self.data.ctrl[self._arm_indices()[2]] = action
 
     def step(self, nstep: int = 1) -> None:
         """Step, but turn a divergence into a flag the task ends the episode on."""

@@ -22,6 +22,7 @@ import collections
 
 import numpy as np
 from dm_control.suite import base
+from dm_env import specs
 
 from robostrich_suite import randomization as randomization_lib
 from robostrich_suite import rewards
@@ -110,8 +111,14 @@ class Reach(base.Task):
     def next_target(self) -> np.ndarray:
         return self.target_pool[self.random.randint(len(self.target_pool))].copy()
 
+    def action_spec(self, physics):
+        """The tendon contractions (m), named after the tendons; nothing else is actuated."""
+        low, high = physics.arm_control_range().T
+        return specs.BoundedArray((len(low),), np.float64, low, high,
+                                  name="\t".join(physics.tendon_names()))
+
     def before_step(self, action, physics):
-        physics.set_control(check_action(action, physics.model.actuator_ctrlrange))
+        physics.set_arm_control(check_action(action, physics.arm_control_range()))
 
     def after_step(self, physics):
         # Remember where the arm is for the next episode of a "continue" lesson.
@@ -162,11 +169,8 @@ class Reach(base.Task):
         obs["attitude_error"] = np.array([np.radians(attitude_error)])
         obs["head_attitude"] = np.array([np.radians(physics.head_attitude())])
         obs["tendon_contraction"] = physics.tendon_contractions()
-        obs["tendon_tension"] = physics.tendon_forces() / self._max_forces(physics)
+        obs["tendon_tension"] = physics.tendon_forces() / physics.tendon_max_forces()
         return obs
-
-    def _max_forces(self, physics):
-        return -physics.model.actuator_forcerange[physics._arm_indices()[2], 0]
 
     def get_reward(self, physics):
         if physics.divergence is not None:

@@ -58,7 +58,6 @@ import numpy as np
 from dm_control import mjcf, mujoco
 from dm_control.rl import control
 from dm_control.utils import containers
-from dm_env import specs
 
 from robostrich_suite import arm as arm_lib
 from robostrich_suite import arm_physics, reach
@@ -232,8 +231,6 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
                 trunk=model.name2id(TRUNK, "body"),
                 leg_actuators=np.array([model.name2id(n, "actuator") for n in legs]),
                 leg_qpos=np.array([model.jnt_qposadr[model.name2id(n, "joint")] for n in legs]),
-                head_body=model.site_bodyid[model.name2id(ARM_PREFIX + arm_lib.HEAD_SITE,
-                                                          "site")],
                 # The arm's first (caudal) joint: the generator adds the chain caudal first.
                 arm_base=next(int(model.jnt_bodyid[i]) for i in range(model.njnt)
                               if model.id2name(i, "joint").startswith(ARM_PREFIX)))
@@ -243,7 +240,7 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
     # Arm head.
     def head_attitude(self) -> float:
         """Head attitude (deg) in the trunk's heading plane: 0 up, 90 level, 180 down."""
-        xmat = self.data.xmat[self._robot()["head_body"]]  # row-major: axis z = (2, 5, 8)
+        xmat = self.data.xmat[self._arm_indices()[5]]  # head body; row-major: axis z = (2, 5, 8)
         hx, hy = self.heading()
         return math.degrees(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8]))
 
@@ -295,12 +292,6 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
     def set_leg_targets(self, targets) -> None:
         self.data.ctrl[self._robot()["leg_actuators"]] = targets
 
-    def set_arm_control(self, action) -> None:
-        self.data.ctrl[self._arm_indices()[2]] = action
-
-    def arm_control_range(self) -> np.ndarray:
-        return self.model.actuator_ctrlrange[self._arm_indices()[2]]
-
     def place_standing(self, trunk_xy=(0.0, 0.0), trunk_height=quad.STANDING_TRUNK_HEIGHT):
         """Put the quadruped in its standing pose, feet on the ground, arm straight, at rest."""
         targets = gait_lib.Standing().joint_targets(0.0, trunk_height + SAG_COMPENSATION["stand"])
@@ -313,7 +304,7 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
         if self.data.act.size:
             self.data.act[:] = 0.0
         self.set_leg_targets(targets)
-        self.data.ctrl[self._arm_indices()[2]] = 0.0
+        self.set_arm_control(0.0)
 
 
 # --- tasks ---------------------------------------------------------------------------
@@ -412,7 +403,7 @@ class _QuadrupedTaskMixin:
         return 1.0 + change * _LEFT_SIGN  # yawed left (error > 0): left legs step longer
 
     def before_step(self, action, physics):
-        physics.set_arm_control(reach.check_action(action, physics.arm_control_range()))
+        super().before_step(action, physics)  # tendons: NaN check, clipping (reach.Reach)
         physics.set_leg_targets(self.leg_targets(physics))
 
     def after_step(self, physics):
@@ -430,11 +421,6 @@ class _QuadrupedTaskMixin:
     # Measurements in the trunk frame.
     def head_xz(self, physics) -> np.ndarray:
         return physics.to_trunk_frame(physics.head_position())[[0, 2]]
-
-    def action_spec(self, physics):
-        low, high = physics.arm_control_range().T
-        return specs.BoundedArray((len(low),), np.float64, low, high,
-                                  name="\t".join(physics.tendon_names()))
 
     def get_observation(self, physics):
         """Table 2 (head, joints, trunk), then the goal and tendon state (module doc)."""

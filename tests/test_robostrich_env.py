@@ -7,7 +7,7 @@ from absl.testing import absltest
 from dm_env import test_utils
 
 import robostrich_suite
-from robostrich_suite import reach, rewards, targets
+from robostrich_suite import rewards, targets
 
 TASKS = robostrich_suite.TASKS_BY_DOMAIN["robostrich"]
 

@@ -1,6 +1,5 @@
 """Wires networks, learner, replay, actor and loop for one environment's specs."""
 import jax
-import numpy as np
 
 from agents.actors import ActionAdapter, Actor
 from agents.loop import EnvironmentLoop
