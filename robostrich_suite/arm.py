@@ -146,15 +146,20 @@ class ArmSpec:
 
 @dataclasses.dataclass(frozen=True)
 class TendonSpec:
-    """One tendon: anchored on the base, through ``links`` (caudal to cranial).
+    """One tendon through the holes of ``links`` (caudal to cranial) on ``side``.
 
-    The last link in ``links`` is the insertion.  Each link contributes its
-    hole on ``side``; the anchor on the base counts as the first point, so a
-    tendon needs at least two holes to act on a joint beyond the first.
+    The last link in ``links`` is the insertion.  With ``on_base`` (default) the
+    tendon starts at an anchor on the base, below the first joint, and the
+    servo pulls it there.  Without, it is tied at the hole of ``links[0]`` and
+    acts only on the joints between its first and last link, like one slip of a
+    neck muscle running between two vertebrae (the servo is an idealised
+    length actuator of that stretch).  Either way a tendon needs at least two
+    holes.
     """
     name: str
     side: str
     links: tuple[str, ...]
+    on_base: bool = True
 
     @property
     def insertion(self) -> str:
@@ -163,7 +168,11 @@ class TendonSpec:
     @classmethod
     def spanning(cls, name: str, side: str, insertion: str, spec: ArmSpec,
                  origin: str | None = None) -> "TendonSpec":
-        """A tendon through every link from ``origin`` (default: the base link) to ``insertion``."""
+        """A tendon through every link from ``origin`` to ``insertion``.
+
+        Without ``origin`` it is anchored on the base and runs from the base link;
+        with one, it is tied at the origin link's hole (``on_base=False``).
+        """
         names = spec.joint_names
         origin = origin or spec.base_link
         for link in (origin, insertion):
@@ -172,7 +181,7 @@ class TendonSpec:
         i, j = names.index(insertion), names.index(origin)
         if i > j:
             raise ValueError(f"tendon {name!r}: insertion {insertion!r} is caudal of origin {origin!r}")
-        return cls(name, side, tuple(reversed(names[i:j + 1])))
+        return cls(name, side, tuple(reversed(names[i:j + 1])), on_base=origin == spec.base_link)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -203,6 +212,28 @@ class TendonLayout:
         dorsal = TendonSpec.spanning("dorsal", "dorsal", spec.head_name, spec)
         ventral = [TendonSpec.spanning(f"ventral_{link}", "ventral", link, spec)
                    for link in cls.ROBOSTRICH_VENTRAL_INSERTIONS]
+        return cls((dorsal, *ventral))
+
+    @classmethod
+    def ventral_slips(cls, spec: ArmSpec | None = None, span: int = 4) -> "TendonLayout":
+        """The paper's dorsal tendon with 8 ventral *slips*: each inserts where the
+        default layout's ventral tendon does but is tied ``span`` joints caudal of its
+        insertion (at the base at most), like the overlapping slips of the ostrich's
+        M. longus colli ventralis.  Each slip then bends only its own stretch of the
+        neck instead of everything between the base and its insertion."""
+        spec = spec or ArmSpec.from_table1()
+        if not isinstance(span, int) or span < 1:
+            raise ValueError(f"span must be a positive number of joints, got {span!r}")
+        names = spec.joint_names
+        dorsal = TendonSpec.spanning("dorsal", "dorsal", spec.head_name, spec)
+        ventral = []
+        for link in cls.ROBOSTRICH_VENTRAL_INSERTIONS:
+            if link not in names:
+                raise ValueError(f"ventral slips: the spec has no link {link!r}; "
+                                 f"links are {list(names)}")
+            origin = names[min(names.index(link) + span, len(names) - 1)]
+            ventral.append(TendonSpec.spanning(f"ventral_{link}", "ventral", link, spec,
+                                               origin=origin))
         return cls((dorsal, *ventral))
 
     def validate(self, spec: ArmSpec) -> None:
@@ -303,13 +334,14 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
         parent, pos = body, length
 
     for tendon in layout.tendons:
-        anchor = base.add("site", name=_anchor_site_name(tendon.name),
-                          pos=[side_x[tendon.side], 0, -spec.anchor_depth],
-                          size=[0.003], rgba=[0.2, 0.7, 0.2, 1])
         element = model.tendon.add("spatial", name=tendon.name, dclass="tendon",
                                    rgba=[0.1, 0.5, 0.9, 1] if tendon.side == "ventral"
                                    else [0.9, 0.2, 0.2, 1])
-        element.add("site", site=anchor)
+        if tendon.on_base:
+            anchor = base.add("site", name=_anchor_site_name(tendon.name),
+                              pos=[side_x[tendon.side], 0, -spec.anchor_depth],
+                              size=[0.003], rgba=[0.2, 0.7, 0.2, 1])
+            element.add("site", site=anchor)
         for link in tendon.links:
             element.add("site", site=_hole_site_name(link, tendon.side))
 

@@ -71,14 +71,17 @@ head travel, start to end):
       73-185 deg for waves and levers alike.
     hole_fraction 0.2 or 0.8:         the static poses are still a one-parameter
       family (attitude differs by 0.5 deg between heads within 15 mm).
-    ventral tendons spanning k joints each (built for the experiment only),
-      dorsal length held: every pattern keeps the attitude (k = 2: wave 5.7 deg /
-      61 mm, lever 6.7 deg / 409 mm); dorsal input held (the dorsal tendon's
-      servo stretch now lets the attitude follow the total ventral pull, which
-      the lever raises and the wave does not): k = 4, wave two tendons wide
-      30.0 deg / 285 mm vs lever 66.0 deg / 311 mm (ratio 0.45), but 0.46-0.61
-      for k = 3, 5 or dorsal -0.01/-0.03 m, at head travels differing up to 2x,
-      and the head swings (path 2-4x the travel).
+    ventral slips (``--ventral-span K``, ``TendonLayout.ventral_slips``: each ventral
+      tendon tied K joints caudal of its insertion, so it bends only its stretch):
+      dorsal *length* held: the static poses (K = 4, 300 random inputs) now cover a
+      2-D head region (0.05-0.47 m forward, 0.28-0.63 m up), but every settled
+      attitude lies in 80-102 deg: the held length keeps the attitude whatever the
+      pattern (K = 2: wave 12.2 deg / 90 mm, lever 12.5 deg / 408 mm), and for
+      K >= 3 the length hold makes the floppy neck swing (head paths of metres).
+      Dorsal *input* held, the lever's amplitude bisected until its head travel
+      equals the wave's: ratio 0.33-0.60 over K = 3-6, dorsal -0.01 to -0.03 m and
+      joints of 1 or 3 N m/rad, but 0.85-3.6 with 6 N m/rad, and the wave's head
+      path is 3-15x its travel (the head swings each time a slip lets go).
 
 So no tried configuration gives a robust difference (rolling range below half
 the lever's at head travels within 25 %, across neighbouring settings).
@@ -327,12 +330,13 @@ class PoseFamily:
 
 def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int = 0,
                 spec: arm_lib.ArmSpec | None = None, settle_time: float = 3.0,
-                progress: bool = False) -> PoseFamily:
+                progress: bool = False, layout: arm_lib.TendonLayout | None = None
+                ) -> PoseFamily:
     """Hold the dorsal length at ``dorsal`` and random ventral inputs; record where the head
     comes to rest.  Inputs are drawn as ``u**2`` times each tendon's range (more small
     contractions, where the head moves most), a third of them with four tendons slack."""
     spec = spec or arm_lib.ArmSpec.from_table1()
-    physics = workspace.frame_physics(spec)
+    physics = workspace.frame_physics(spec, layout)
     model = physics.model
     ventral, dorsal_id = ventral_order(physics), dorsal_index(physics)
     tendon_ids = model.actuator_trnid[:, 0]
@@ -454,6 +458,10 @@ def main(argv=None) -> dict:
                         help="hold the dorsal tendon's length or its input (default: %(default)s)")
     parser.add_argument("--joint-stiffness", type=float, default=None,
                         help="override the passive joint stiffness, N m/rad (default: the arm's)")
+    parser.add_argument("--ventral-span", type=int, default=None, metavar="K",
+                        help="use ventral slips tied K joints caudal of their insertions "
+                             "(TendonLayout.ventral_slips) instead of the paper's layout, whose "
+                             "ventral tendons all run from the base (default: the paper's)")
     parser.add_argument("--input-noise", type=float, default=0.0,
                         help="std (m) of Gaussian noise added to the ventral inputs every "
                              "control step, to see how robust a pattern is (default: %(default)s)")
@@ -470,6 +478,8 @@ def main(argv=None) -> dict:
 
     overrides = {} if args.joint_stiffness is None else {"joint_stiffness": args.joint_stiffness}
     spec = arm_lib.ArmSpec.from_table1(**overrides)
+    layout = (None if args.ventral_span is None
+              else arm_lib.TendonLayout.ventral_slips(spec, args.ventral_span))
     written, results = [], {}
     start = time.perf_counter()
     for pattern in args.patterns:
@@ -480,7 +490,8 @@ def main(argv=None) -> dict:
         if not args.no_recording:
             from robostrich_suite import rerun_log
             recording = rerun_log.recording(f"robostrich_movement_{pattern}", rrd)
-        movement = run(config, spec, recording=recording, progress=not args.no_progress)
+        movement = run(config, spec, workspace.frame_physics(spec, layout), recording=recording,
+                       progress=not args.no_progress)
         if recording is not None:
             recording.flush()
             written.append(rrd)
@@ -493,7 +504,7 @@ def main(argv=None) -> dict:
               f"range {s['attitude_range_deg']:.1f} deg")
     if args.pose_family > 0:
         family = pose_family(args.pose_family, args.dorsal, args.seed, spec,
-                             progress=not args.no_progress)
+                             progress=not args.no_progress, layout=layout)
         near, far = family.attitude_spread()
         print(f"static poses at dorsal {args.dorsal} m: {family.settled.sum()} of "
               f"{args.pose_family} settled; attitude differs by a median {near:.1f} deg between "

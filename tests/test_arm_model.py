@@ -151,3 +151,55 @@ def test_bad_layout_raises_naming_the_item(tendons, message):
 def test_spanning_rejects_unknown_insertion():
     with pytest.raises(ValueError, match="unknown link 'neck'"):
         arm.TendonSpec.spanning("t", "ventral", "neck", arm.ArmSpec.from_table1())
+
+
+def _tendon_joints(physics, tendon):
+    """Names of the joints whose rotation changes a tendon's length (by finite differences
+    from the straight pose: MuJoCo stores the tendon Jacobian sparsely)."""
+    joints = [physics.model.id2name(j, "joint") for j in range(physics.model.njnt)]
+    moved = set()
+    for joint in joints:
+        with physics.reset_context():
+            base = float(physics.named.data.ten_length[tendon])
+        with physics.reset_context():
+            physics.named.data.qpos[joint] = 0.05
+        if abs(physics.named.data.ten_length[tendon] - base) > 1e-6:
+            moved.add(joint.split("/")[-1])
+    return moved
+
+
+def test_tendon_tied_between_vertebrae_acts_only_on_its_own_joints():
+    spec = arm.ArmSpec.from_table1()
+    slip = arm.TendonSpec.spanning("slip", "ventral", "c6", spec, origin="c10")
+    assert not slip.on_base and slip.links == ("c10", "c9", "c8", "c7", "c6")
+    layout = arm.TendonLayout((arm.TendonSpec.spanning("dorsal", "dorsal", "atlas", spec), slip))
+    physics = mjcf.Physics.from_mjcf_model(arm.build_frame_arm(spec, layout))
+    assert physics.model.tendon_num.tolist() == [19, 5]  # base anchor + 18 holes; 5 holes
+    assert _tendon_joints(physics, "arm/slip") == {"c9", "c8", "c7", "c6"}
+    assert len(_tendon_joints(physics, "arm/dorsal")) == 18
+    # Without gravity and with the dorsal tendon paid out (slack), contracting the slip
+    # flexes exactly those joints ventrally.
+    physics.model.opt.gravity[:] = 0
+    physics.named.data.ctrl["arm/dorsal"] = physics.named.model.actuator_ctrlrange["arm/dorsal"][0]
+    physics.named.data.ctrl["arm/slip"] = physics.named.model.actuator_ctrlrange["arm/slip"][1]
+    for _ in range(3000):
+        physics.step()
+    angles = dict(zip(spec.joint_names, np.degrees(physics.named.data.qpos[
+        [f"arm/{n}" for n in spec.joint_names]])))
+    # Measured: 24-26 deg inside; outside, the floppy chain still rocks by ~1 deg from
+    # the reaction of the bend (weak joints, no gravity to settle it).
+    assert all(angles[n] > 15 for n in ("c9", "c8", "c7", "c6"))  # ventral flexion
+    assert all(abs(angles[n]) < 2 for n in angles if n not in ("c9", "c8", "c7", "c6"))
+
+
+def test_ventral_slips_layout():
+    spec = arm.ArmSpec.from_table1()
+    layout = arm.TendonLayout.ventral_slips(spec, span=4)
+    assert layout.names == arm.TendonLayout.robostrich(spec).names
+    slips = layout.tendons[1:]
+    assert [t.links[0] for t in slips] == ["c18", "c18", "c16", "c14", "c12", "c10", "c8", "c6"]
+    assert [t.on_base for t in slips] == [True, True] + [False] * 6  # c18 is the base link
+    physics = mjcf.Physics.from_mjcf_model(arm.build_frame_arm(spec, layout))
+    assert _tendon_joints(physics, "arm/ventral_c8") == {"c11", "c10", "c9", "c8"}
+    with pytest.raises(ValueError, match="span must be a positive"):
+        arm.TendonLayout.ventral_slips(spec, span=0)
