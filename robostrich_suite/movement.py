@@ -461,8 +461,10 @@ def plot_movement(movement: Movement, path: str | pathlib.Path, num_sticks: int 
     low, high = ax_in.get_ylim()
     ax_in.set_ylim(low, high + 0.9 * (high - low))  # headroom for the legend
     ax_in.legend(fontsize=7, ncol=4, loc="upper left")
+    span = movement.config.ventral_span
+    tendons = "ventral tendons from the base" if span is None else f"ventral slips of {span} joints"
     ax_in.set_title(f"(A) tendon inputs, {movement.config.pattern} pattern "
-                    f"(dorsal {movement.config.dorsal_hold} held)", fontsize=10)
+                    f"({tendons}, dorsal {movement.config.dorsal_hold} held)", fontsize=10)
     ax_att.plot(movement.time, movement.head_attitude, color="k")
     ax_att.axvspan(0, SETTLE_TIME, color="0.9", label="settling to the start pose")
     summary = movement.summary()
