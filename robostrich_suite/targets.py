@@ -52,43 +52,67 @@ def distinct_indices(positions: np.ndarray, spacing: float = MIN_TARGET_SPACING)
 
 
 @functools.lru_cache(maxsize=None)
-def _distinct_targets() -> np.ndarray:
-    positions = level_head_poses()["head_position"]
+def _distinct_targets(path: str = str(DATA_PATH)) -> np.ndarray:
+    positions = _load(path)["head_position"]
     return positions[distinct_indices(positions)]
 
 
-def _split(heldout: bool) -> np.ndarray:
-    positions = _distinct_targets()
+def _split(heldout: bool, path: str = str(DATA_PATH)) -> np.ndarray:
+    positions = _distinct_targets(str(path))
     mask = (np.arange(len(positions)) % HELDOUT_EVERY == 0)
     return positions[mask if heldout else ~mask].copy()
 
 
-def training_targets() -> np.ndarray:
-    """(n, 2) target positions (x, z) the training tasks sample from."""
-    return _split(heldout=False)
+def training_targets(path: str | pathlib.Path = DATA_PATH) -> np.ndarray:
+    """(n, 2) target positions (x, z) the training tasks sample from (from the shipped
+    poses, or from a file :func:`generate` wrote for another arm)."""
+    return _split(False, str(path))
 
 
-def heldout_targets() -> np.ndarray:
+def heldout_targets(path: str | pathlib.Path = DATA_PATH) -> np.ndarray:
     """(n, 2) target positions (x, z) kept out of training, for evaluation."""
-    return _split(heldout=True)
+    return _split(True, str(path))
+
+
+def warn_if_other_arm(spec=None, layout=None) -> bool:
+    """Warn (and return True) when the shipped targets were made with another arm than
+    ``spec``/``layout``: its level-head poses differ, so some targets may be out of reach
+    or not holdable with a level head."""
+    from robostrich_suite import workspace
+    if spec is None and layout is None:
+        return False
+    shipped = str(level_head_poses()["fingerprint"])
+    if workspace.model_fingerprint(spec, layout) == shipped:
+        return False
+    import warnings
+    warnings.warn(
+        "the shipped targets were made with the default arm, not this arm spec/tendon layout; "
+        "some may be unreachable. Make targets for it with robostrich_suite.targets.generate("
+        "..., spec=..., layout=..., path=FILE) and pass target_pool=training_targets(FILE).",
+        stacklevel=3)
+    return True
 
 
 def generate(num_samples: int, seed: int = 0, path: pathlib.Path = DATA_PATH,
              workers: int = 2, append: bool = False,
-             seek_level_time: float = SEEK_LEVEL_TIME) -> int:
+             seek_level_time: float = SEEK_LEVEL_TIME, spec=None, layout=None) -> int:
     """Sample the actuated workspace and save its level subset; returns its size.
 
     ``seek_level_time`` > 0 tunes each draw's dorsal input towards a level head
     before holding it (:func:`robostrich_suite.workspace.seek_level`): many more
     level poses per CPU second.  With ``append`` the new poses are added to those
     already in ``path`` (which must come from the same arm); use another seed.
+    ``spec`` and ``layout`` (an ``ArmSpec`` and ``TendonLayout``) make targets for
+    another arm; write them to another ``path`` and pass :func:`load_targets` of it
+    as the tasks' ``target_pool``.
     """
     from robostrich_suite import workspace
     samples = workspace.actuated_samples_parallel(num_samples, seed=seed, workers=workers,
                                                   progress=True,
-                                                  seek_level_time=seek_level_time)
+                                                  seek_level_time=seek_level_time,
+                                                  spec=spec, layout=layout)
     level = samples.level()
-    fingerprint = workspace.model_fingerprint()
+    fingerprint = workspace.model_fingerprint(spec, layout)
     new = dict(head_position=samples.head_position[level],
                head_attitude=samples.head_attitude[level], control=samples.control[level])
     if append and path.exists():

@@ -1,8 +1,11 @@
 """Targets come from poses the arm really held with its head level."""
+import warnings
+
 import numpy as np
 import pytest
 
-from robostrich_suite import targets, workspace
+import robostrich_suite
+from robostrich_suite import arm, targets, workspace
 
 
 def test_pose_set_was_made_with_the_current_arm():
@@ -30,3 +33,29 @@ def test_stored_inputs_really_hold_the_head_level_there(index):
     np.testing.assert_allclose(workspace.head_position_xz(physics),
                                poses["head_position"][index], atol=1e-6)
     assert abs(workspace.head_attitude_deg(physics) - 90) <= 5
+
+
+def test_another_arm_gets_a_warning_and_its_own_targets(tmp_path):
+    slips = arm.TendonLayout.ventral_slips(span=4)
+    with pytest.warns(UserWarning, match="shipped targets were made with the default arm"):
+        robostrich_suite.load("robostrich", "lesson1",
+                              task_kwargs=dict(tendon_layout=slips))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the default arm, passed explicitly: no warning
+        robostrich_suite.load("robostrich", "lesson1",
+                              task_kwargs=dict(arm_spec=arm.ArmSpec.from_table1()))
+
+    path = tmp_path / "slip_targets.npz"
+    count = targets.generate(12, seed=3, path=path, workers=1, spec=None, layout=slips)
+    with np.load(path) as data:
+        assert str(data["fingerprint"]) == workspace.model_fingerprint(None, slips)
+        assert len(data["head_position"]) == count > 0
+        assert np.all(np.abs(data["head_attitude"] - 90) <= 5)
+    pool = np.concatenate([targets.training_targets(path), targets.heldout_targets(path)])
+    assert len(pool) >= 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        env = robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(
+            tendon_layout=slips, target_pool=pool))
+    env.reset()
+    assert any(np.allclose(env.task.target_position, p) for p in pool)
