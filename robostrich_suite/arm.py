@@ -170,8 +170,8 @@ class TendonSpec:
                  origin: str | None = None) -> "TendonSpec":
         """A tendon through every link from ``origin`` to ``insertion``.
 
-        Without ``origin`` it is anchored on the base and runs from the base link;
-        with one, it is tied at the origin link's hole (``on_base=False``).
+        Without ``origin`` (or with the base link) it is anchored on the base; with
+        another link, it is tied at that link's hole (``on_base=False``).
         """
         names = spec.joint_names
         origin = origin or spec.base_link

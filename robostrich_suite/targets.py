@@ -103,8 +103,8 @@ def generate(num_samples: int, seed: int = 0, path: pathlib.Path = DATA_PATH,
     level poses per CPU second.  With ``append`` the new poses are added to those
     already in ``path`` (which must come from the same arm); use another seed.
     ``spec`` and ``layout`` (an ``ArmSpec`` and ``TendonLayout``) make targets for
-    another arm; write them to another ``path`` and pass :func:`load_targets` of it
-    as the tasks' ``target_pool``.
+    another arm; write them to another ``path`` and pass
+    ``training_targets(path)`` as the tasks' ``target_pool``.
     """
     from robostrich_suite import workspace
     samples = workspace.actuated_samples_parallel(num_samples, seed=seed, workers=workers,
