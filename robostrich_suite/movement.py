@@ -180,6 +180,20 @@ def dorsal_index(physics: mjcf.Physics) -> int:
     return next(i for i, n in enumerate(names) if n.endswith("dorsal"))
 
 
+def servo_rest_lengths(model) -> np.ndarray:
+    """Each tendon servo's length at zero input (the affine bias is kp * rest length);
+    a tendon's contraction is this minus its current length."""
+    return model.actuator_biasprm[:, 0] / -model.actuator_gainprm[:, 0]
+
+
+def hold_dorsal_length(dorsal_input: float, target: float, contraction: float, dt: float,
+                       control_range) -> float:
+    """One step of the integral loop that holds the dorsal tendon at ``target`` contraction
+    by moving its input against the servo's own stretch."""
+    return float(np.clip(dorsal_input + DORSAL_HOLD_GAIN * dt * (target - contraction),
+                         *control_range))
+
+
 def schedule(config: MovementConfig, physics: mjcf.Physics):
     """``f(t) -> contraction targets`` for every tendon (dorsal: the held contraction).
 
@@ -272,8 +286,7 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
     dorsal = dorsal_index(physics)
     model = physics.model
     tendon_ids = model.actuator_trnid[:, 0]
-    kp = -model.actuator_gainprm[:, 0]
-    rest = model.actuator_biasprm[:, 0] / kp
+    rest = servo_rest_lengths(model)
     targets = schedule(config, physics)
     dt = model.opt.timestep
     steps = int(round(config.duration(len(ventral)) / dt))
@@ -301,8 +314,8 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
             x = np.clip(x + noise, *model.actuator_ctrlrange.T)
         contraction = rest - physics.data.ten_length[tendon_ids]
         if config.dorsal_hold == "length":
-            dorsal_input += DORSAL_HOLD_GAIN * dt * (x[dorsal] - contraction[dorsal])
-            dorsal_input = float(np.clip(dorsal_input, *model.actuator_ctrlrange[dorsal]))
+            dorsal_input = hold_dorsal_length(dorsal_input, x[dorsal], contraction[dorsal], dt,
+                                              model.actuator_ctrlrange[dorsal])
             x[dorsal] = dorsal_input
         physics.data.ctrl[:] = x
         if k % RECORD_EVERY == 0:
@@ -403,7 +416,7 @@ def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int
     model = physics.model
     ventral, dorsal_id = ventral_order(physics), dorsal_index(physics)
     tendon_ids = model.actuator_trnid[:, 0]
-    rest = model.actuator_biasprm[:, 0] / -model.actuator_gainprm[:, 0]
+    rest = servo_rest_lengths(model)
     high = model.actuator_ctrlrange[ventral, 1]
     rng = np.random.default_rng(seed)
     inputs = rng.uniform(size=(num_poses, len(ventral))) ** 2 * high
@@ -422,9 +435,8 @@ def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int
         for k in range(int(round(settle_time / dt))):
             ramp = min(k * dt / RAMP_IN_TIME, 1.0)
             contraction = rest[dorsal_id] - physics.data.ten_length[tendon_ids[dorsal_id]]
-            dorsal_input = float(np.clip(dorsal_input + DORSAL_HOLD_GAIN * dt
-                                         * (ramp * dorsal - contraction),
-                                         *model.actuator_ctrlrange[dorsal_id]))
+            dorsal_input = hold_dorsal_length(dorsal_input, ramp * dorsal, contraction, dt,
+                                              model.actuator_ctrlrange[dorsal_id])
             physics.data.ctrl[dorsal_id] = dorsal_input
             physics.data.ctrl[ventral] = ramp * inputs[i]
             physics.step()

@@ -157,10 +157,10 @@ def _tendon_joints(physics, tendon):
     """Names of the joints whose rotation changes a tendon's length (by finite differences
     from the straight pose: MuJoCo stores the tendon Jacobian sparsely)."""
     joints = [physics.model.id2name(j, "joint") for j in range(physics.model.njnt)]
+    with physics.reset_context():
+        base = float(physics.named.data.ten_length[tendon])
     moved = set()
     for joint in joints:
-        with physics.reset_context():
-            base = float(physics.named.data.ten_length[tendon])
         with physics.reset_context():
             physics.named.data.qpos[joint] = 0.05
         if abs(physics.named.data.ten_length[tendon] - base) > 1e-6:
