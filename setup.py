@@ -32,12 +32,12 @@ setup(
     },
     entry_points={
         "console_scripts": [
-            "robostrich-train = agents.training:main",
-            "robostrich-evaluate = agents.evaluation:main",
-            "robostrich-walk = robostrich_suite.walk:main",
-            "robostrich-export-xml = robostrich_suite.xml_export:main",
-            "robostrich-movement = robostrich_suite.movement:main",
-            "robostrich-workspace = robostrich_suite.workspace:main",
+            "robostrich-train = agents.training:cli",
+            "robostrich-evaluate = agents.evaluation:cli",
+            "robostrich-walk = robostrich_suite.walk:cli",
+            "robostrich-export-xml = robostrich_suite.xml_export:cli",
+            "robostrich-movement = robostrich_suite.movement:cli",
+            "robostrich-workspace = robostrich_suite.workspace:cli",
         ],
     },
 )

@@ -40,8 +40,8 @@ def save(path: str, payload: dict, fingerprint: dict) -> None:
         raise
 
 
-def load(path: str, fingerprint: dict = None) -> dict:
-    """Returns the payload; raises CheckpointError if damaged or if `fingerprint` differs."""
+def _read_record(path: str) -> dict:
+    """The stored record after checking header, checksum, pickle and format version; CheckpointError if not."""
     with open(path, "rb") as f:
         data = f.read()
     if len(data) < len(MAGIC) + 32 or data[:len(MAGIC)] != MAGIC:
@@ -53,17 +53,23 @@ def load(path: str, fingerprint: dict = None) -> dict:
         record = pickle.loads(body)
     except Exception as e:  # a valid checksum over an unreadable pickle: wrong code version
         raise CheckpointError(f"{path} cannot be unpickled: {e}") from e
-    if record.get("format_version") != FORMAT_VERSION:
-        raise CheckpointError(f"{path} has format version {record.get('format_version')}, expected {FORMAT_VERSION}")
+    if not isinstance(record, dict) or record.get("format_version") != FORMAT_VERSION:
+        version = record.get("format_version") if isinstance(record, dict) else None
+        raise CheckpointError(f"{path} has format version {version}, expected {FORMAT_VERSION}")
+    return record
+
+
+def load(path: str, fingerprint: dict = None) -> dict:
+    """Returns the payload; raises CheckpointError if damaged or if `fingerprint` differs."""
+    record = _read_record(path)
     if fingerprint is not None:
         check_fingerprint(record["fingerprint"], fingerprint, path)
     return record["payload"]
 
 
 def read_fingerprint(path: str) -> dict:
-    with open(path, "rb") as f:
-        data = f.read()
-    return pickle.loads(data[len(MAGIC) + 32:])["fingerprint"]
+    """The configuration that wrote `path`; raises CheckpointError if the file is damaged (as `load` does)."""
+    return _read_record(path)["fingerprint"]
 
 
 def _flatten(d, prefix=""):

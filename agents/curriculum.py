@@ -146,10 +146,10 @@ class CurriculumRun:
         self.lesson_index, self.lesson_steps = state["lesson_index"], state["lesson_steps"]
         if state["environment"] is not None:
             env, timestep, obs = pickle.loads(zlib.decompress(state["environment"]))
-            loop.set_environment(env)
+            loop.set_environment(env, close_episode=False)
             loop.timestep, loop._obs = timestep, obs
         elif not self.done:
-            loop.set_environment(self._make_lesson_env(self.lesson_index))
+            loop.set_environment(self._make_lesson_env(self.lesson_index), close_episode=False)
         loop.load_state_dict(state["loop"])
         loop.latest_metrics = state.get("latest_metrics", {})
         for p in (self.metrics_path, self.evals_path):  # drop records written after the checkpoint

@@ -1,6 +1,10 @@
 """Evaluation of the deterministic policy: held-out targets and the three-target `track` task (Fig. 7).
 
-Writes one JSON report per evaluation. `main` (console command
+On the arm every held-out target is tried from the fixed start (`heldout`) and
+from three poses where the arm holds another target (`heldout_moving`), and
+the no-learning `lookup` baseline (agents/lookup.py) is evaluated beside the
+agents.  Other dm_control domains report episode returns.  Writes one JSON
+report per evaluation. `main` (console command
 `robostrich-evaluate`) loads a checkpoint and writes the same reports,
 figures and Rerun recordings as the end of a training run.
 """
@@ -50,6 +54,9 @@ def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dic
 def _episode_summary(series, start=0, end=None) -> dict:
     pe = np.asarray(series["position_error"][start:end])
     ae = np.asarray(series["attitude_error"][start:end])
+    episode_return = float(np.sum(series["reward"][start:end]))
+    if np.all(np.isnan(pe)):  # a domain without a head or target (e.g. reacher): its return is all there is
+        return {"return": episode_return, "steps": int(pe.size)}
     within = (pe <= probes.POSITION_TOLERANCE) & (ae <= probes.ATTITUDE_TOLERANCE)
     reached = np.flatnonzero(within)
     return {
@@ -57,11 +64,17 @@ def _episode_summary(series, start=0, end=None) -> dict:
         "min_position_error": float(pe.min()),
         "success": probes.is_success(pe[-1], ae[-1]),
         "steps_to_reach": int(reached[0] + 1) if reached.size else None,
-        "steps": int(pe.size),
+        "steps": int(pe.size), "return": episode_return,
     }
 
 
 def summarize(episodes) -> dict:
+    """Success and final errors (robostrich, point_mass); only return statistics where errors are unknown."""
+    returns = np.array([e["return"] for e in episodes], np.float64)
+    return_stats = {"return_mean": float(returns.mean()), "return_std": float(returns.std()),
+                    "return_min": float(returns.min()), "return_max": float(returns.max())}
+    if any("final_position_error" not in e for e in episodes):
+        return {"episodes": len(episodes), **return_stats}
     pe = np.array([e["final_position_error"] for e in episodes])
     ae = np.array([e["final_attitude_error"] for e in episodes])
     reach = [e["steps_to_reach"] for e in episodes if e["steps_to_reach"] is not None]
@@ -73,6 +86,7 @@ def summarize(episodes) -> dict:
         "reached_fraction": len(reach) / len(episodes),
         "steps_to_reach_median": float(np.median(reach)) if reach else None,
         "position_tolerance_m": probes.POSITION_TOLERANCE, "attitude_tolerance_deg": probes.ATTITUDE_TOLERANCE,
+        **return_stats,
     }
 
 
@@ -115,6 +129,45 @@ def evaluate_heldout(actor, flattener, domain: str, task: str, num_targets: Opti
     return {"kind": "heldout", "domain": domain, "task": task, "summary": summarize(episodes), "episodes": episodes}
 
 
+def moving_starts(count: int = 3):
+    """Start poses of `heldout_moving`: `count` well separated training targets (picked as `track` picks its
+    targets) and the stored inputs that hold them (from the lookup table, so never a held-out pose)."""
+    from agents.lookup import lookup_table, nearest
+    from robostrich_suite import reach, targets
+    table = lookup_table()
+    starts = reach.default_track_targets(targets.training_targets(), count)
+    return starts, np.stack([table["control"][nearest(table, s)] for s in starts])
+
+
+def evaluate_heldout_moving(actor, flattener, domain: str = "robostrich", num_targets: Optional[int] = None,
+                            seed: int = 30_000, targets=None, starts=None, action_repeat: int = 1) -> dict:
+    """Every held-out target from poses where the arm holds another target (lesson 3's situation).
+
+    One lesson-3 environment: per (start, target), an episode from the fixed
+    pose holds the start's stored inputs (2 s: the arm comes to rest there),
+    then the task's `continue` initial state starts the evaluated episode from
+    that final state, with the held-out target.  `starts` = (positions, controls).
+    """
+    targets = heldout_targets(domain, num_targets) if targets is None else np.asarray(targets, np.float64)
+    start_positions, start_controls = moving_starts() if starts is None else starts
+    env = make_environment(domain, "lesson3", seed, target_pool=targets[:1])
+    episodes = []
+    for k, (start, control) in enumerate(zip(start_positions, start_controls)):
+        for target in targets:
+            env.task.initial_state, env.task.target_pool = "fixed", np.asarray(start, np.float64)[None]
+            timestep = env.reset()
+            while not timestep.last():
+                timestep = env.step(control)
+            start_error = probes.head_errors(env)
+            env.task.initial_state, env.task.target_pool = "continue", np.asarray(target, np.float64)[None]
+            row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat))
+            row.update(target=np.asarray(target).tolist(), start=k, start_target=np.asarray(start).tolist(),
+                       start_position_error=start_error[0], start_attitude_error=start_error[1])
+            episodes.append(row)
+    return {"kind": "heldout_moving", "domain": domain, "task": "lesson3", "summary": summarize(episodes),
+            "episodes": episodes}
+
+
 def evaluate_track(actor, flattener, domain: str = "robostrich", task: str = "track", seed: int = 20_000,
                    recorder=None, action_repeat: int = 1) -> dict:
     """The `track` task: targets in order (Fig. 7); one summary per target segment plus the series."""
@@ -134,10 +187,14 @@ def evaluate_track(actor, flattener, domain: str = "robostrich", task: str = "tr
 def evaluate_agent(actor, flattener, out_dir: str, label: str, domain: str, heldout_task: str,
                    track_task: Optional[str], num_targets: Optional[int] = None, env_steps: int = None,
                    record: bool = True, action_repeat: int = 1) -> dict:
-    """Held-out + track evaluation, JSON reports and (optionally) a Rerun recording of the track rollout."""
+    """Held-out (+ from moving starts on the arm) + track evaluation, JSON reports and (optionally) a Rerun
+    recording of the track rollout."""
     os.makedirs(out_dir, exist_ok=True)
     reports = {"heldout": evaluate_heldout(actor, flattener, domain, heldout_task, num_targets,
                                            action_repeat=action_repeat)}
+    if domain in ROBOSTRICH_DOMAINS:
+        reports["heldout_moving"] = evaluate_heldout_moving(actor, flattener, domain, num_targets,
+                                                            action_repeat=action_repeat)
     if track_task:
         recorder = None
         if record:
@@ -153,6 +210,21 @@ def evaluate_agent(actor, flattener, out_dir: str, label: str, domain: str, held
         report.update(label=label, env_steps=env_steps)
         write_json(os.path.join(out_dir, f"{label}_{kind}.json"), report)
     return reports
+
+
+def evaluate_lookup(out_dir: str, domain: str, heldout_task: str, track_task: Optional[str],
+                    num_targets: Optional[int] = None, record: bool = True) -> Optional[dict]:
+    """`evaluate_agent` for the lookup baseline (label `lookup`) on the arm; None on other domains.
+
+    Action repeat 1: the lookup's input only changes with the target.
+    """
+    if domain not in ROBOSTRICH_DOMAINS:
+        return None
+    from agents.lookup import LABEL, LookupPolicy
+    from agents.replay import ObservationFlattener
+    flattener = ObservationFlattener(make_environment(domain, heldout_task, 0).observation_spec())
+    return evaluate_agent(LookupPolicy(flattener), flattener, out_dir, LABEL, domain, heldout_task, track_task,
+                          num_targets, env_steps=0, record=record, action_repeat=1)
 
 
 def write_json(path: str, obj) -> None:
@@ -186,7 +258,8 @@ def load_run_from_checkpoint(path: str):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description="Evaluate a checkpoint: held-out targets and the track task.")
+    parser = argparse.ArgumentParser(description="Evaluate a checkpoint (and, on the arm, the lookup baseline): "
+                                                 "held-out targets and the track task.")
     parser.add_argument("checkpoint", help="checkpoint.pkl written by robostrich-train")
     parser.add_argument("--out", default=None, help="report directory (default: next to the checkpoint)")
     parser.add_argument("--label", default="eval")
@@ -203,17 +276,30 @@ def main(argv=None):
     from agents.sac.builder import SACBuilder
     actor = SACBuilder.make_eval_actor(run.loop)
     track_task = args.track_task if domain in ROBOSTRICH_DOMAINS else None
-    reports = evaluate_agent(actor, run.loop.flattener, out, args.label, domain,
-                             args.heldout_task or default_heldout_task(domain, run.plan[-1].task),
-                             track_task or None, args.num_targets,
-                             env_steps=run.loop.env_steps, record=not args.no_rerun,
-                             action_repeat=run.config.action_repeat)
-    if not args.no_figures and "track" in reports:
+    heldout_task = args.heldout_task or default_heldout_task(domain, run.plan[-1].task)
+    reports = {args.label: evaluate_agent(actor, run.loop.flattener, out, args.label, domain, heldout_task,
+                                          track_task or None, args.num_targets,
+                                          env_steps=run.loop.env_steps, record=not args.no_rerun,
+                                          action_repeat=run.config.action_repeat)}
+    lookup = evaluate_lookup(out, domain, heldout_task, track_task or None, args.num_targets, not args.no_rerun)
+    if lookup is not None:
+        reports["lookup"] = lookup
+    if not args.no_figures and "track" in reports[args.label]:
         from agents import figures
-        figures.plot_track({args.label: reports["track"]}, os.path.join(out, f"{args.label}_track.png"))
-    print(json.dumps({k: r["summary"] for k, r in reports.items()}, indent=1))
+        figures.plot_track({label: r["track"] for label, r in reports.items()},
+                           os.path.join(out, f"{args.label}_track.png"))
+    summary = {label: {kind: r["summary"] for kind, r in rs.items()} for label, rs in reports.items()}
+    write_json(os.path.join(out, "summary.json"), summary)
+    print(json.dumps(summary, indent=1))
     return reports
 
 
+def cli(argv=None) -> int:
+    """Console script `robostrich-evaluate`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
+    from robostrich_suite import cli as cli_lib
+    return cli_lib.run(main, "robostrich-evaluate", argv)
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+    sys.exit(cli())

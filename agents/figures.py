@@ -23,10 +23,14 @@ def _smooth(x, n):
 
 
 def plot_learning_curves(runs: Dict[str, List[dict]], evals: Dict[str, List[dict]], path: str,
-                         lesson_boundaries=None):
-    """Fig. 7b: training return and success per episode, and held-out position error, curriculum vs SAC."""
+                         lesson_boundaries=None, baselines: Dict[str, dict] = None):
+    """Fig. 7b: training return and success per episode, and held-out position error, curriculum vs SAC.
+
+    `baselines` (label -> held-out summary, e.g. the lookup's) are dashed horizontal lines: the bar to clear.
+    Domains without position errors (e.g. reacher) show the evaluation return instead.
+    """
     fig, axes = plt.subplots(1, 3, figsize=(15, 4))
-    labels = list(dict.fromkeys(list(runs) + list(evals or {})))
+    labels = list(dict.fromkeys(list(runs) + list(evals or {}) + list(baselines or {})))
     color = {label: f"C{i}" for i, label in enumerate(labels)}
     for label, records in runs.items():
         if not records:
@@ -35,14 +39,25 @@ def plot_learning_curves(runs: Dict[str, List[dict]], evals: Dict[str, List[dict
         w = max(1, len(records) // 50)
         axes[0].plot(steps, _smooth([r["return"] for r in records], w), color=color[label], label=label)
         axes[1].plot(steps, _smooth([float(r["success"]) for r in records], w), color=color[label], label=label)
+    has_errors = True
     for label, records in (evals or {}).items():
         if records:
             steps = [r["env_steps"] for r in records]
+            if "position_error_median" not in records[0]["summary"]:
+                has_errors = False
+                axes[2].plot(steps, [r["summary"]["return_mean"] for r in records], "o-", color=color[label],
+                             label=f"{label} mean return")
+                continue
             axes[2].plot(steps, [r["summary"]["position_error_median"] for r in records], "o-", color=color[label],
                          label=f"{label} median")
             axes[2].plot(steps, [r["summary"]["position_error_p90"] for r in records], "x--", color=color[label],
                          label=f"{label} p90")
-    axes[2].axhline(probes.POSITION_TOLERANCE, color="k", lw=0.8, ls=":")
+    for label, summary in (baselines or {}).items():
+        axes[1].axhline(summary["success_rate"], color=color[label], ls="--", label=f"{label} held-out success")
+        axes[2].axhline(summary["position_error_median"], color=color[label], ls="--",
+                        label=f"{label} held-out median")
+    if has_errors:
+        axes[2].axhline(probes.POSITION_TOLERANCE, color="k", lw=0.8, ls=":")
     for ax in axes:
         for b in lesson_boundaries or []:
             ax.axvline(b, color="grey", lw=0.6, ls="--")
@@ -51,7 +66,7 @@ def plot_learning_curves(runs: Dict[str, List[dict]], evals: Dict[str, List[dict
         ax.legend(fontsize=8)
     axes[0].set_ylabel("episode return (training)")
     axes[1].set_ylabel("success rate (training episodes)")
-    axes[2].set_ylabel("held-out final position error (m)")
+    axes[2].set_ylabel("held-out final position error (m)" if has_errors else "evaluation episode return")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -11,6 +11,7 @@ import numpy as np
 
 from agents import probes
 from agents.actors import Actor
+from agents.goals import GoalRelabeler
 from agents.replay import ObservationFlattener, ReplayBuffer
 from agents.sac.config import SACConfig
 from agents.sac.learning import SACLearner
@@ -35,9 +36,16 @@ class EnvironmentLoop:
         self.episode_return = 0.0
         self.episode_length = 0
         self._obs = None
+        # The current lesson's goals and reward, when the replay keeps achieved goals.
+        self.relabeler = GoalRelabeler.for_environment(env, self.flattener) if self.replay.goal_width else None
 
-    def set_environment(self, env):
-        """Switch lesson: the learner, actor and replay carry over (Algorithm 1)."""
+    def set_environment(self, env, close_episode: bool = True):
+        """Switch lesson: the learner, actor and replay carry over (Algorithm 1).
+
+        ``close_episode=False`` when a checkpointed environment resumes its open episode.
+        """
+        if close_episode:
+            self.replay.end_episode()
         self._set_env(env)
 
     def _act(self, flat_obs):
@@ -57,6 +65,7 @@ class EnvironmentLoop:
         env, replay, adapter, flatten = self.env, self.replay, self.actor.adapter, self.flattener
         cfg = self.config
         repeat = cfg.action_repeat
+        relabeler = self.relabeler
         start = self.env_steps
         target = start + num_steps
         while self.env_steps < target:
@@ -69,23 +78,29 @@ class EnvironmentLoop:
             env_action = adapter.to_env(policy_action)
             timestep = env.step(env_action)
             reward, discount, taken = float(timestep.reward), float(timestep.discount), 1
+            next_obs = flatten(timestep.observation)
+            substeps = [relabeler.substep(next_obs)] if relabeler is not None else None
             while taken < repeat and not timestep.last():
                 timestep = env.step(env_action)
                 reward += float(timestep.reward)  # as Acme's ActionRepeat: summed, undiscounted
                 discount *= float(timestep.discount)
                 taken += 1
-            next_obs = flatten(timestep.observation)
-            replay.add(obs, policy_action, reward, discount, next_obs)
+                next_obs = flatten(timestep.observation)
+                if substeps is not None:
+                    substeps.append(relabeler.substep(next_obs))
+            replay.add(obs, policy_action, reward, discount, next_obs, substeps)
             self.timestep, self._obs = timestep, next_obs
             self.episode_return += reward
             self.episode_length += taken
             self.env_steps += taken
             self.transitions += 1
             if self.transitions % cfg.env_steps_per_call == 0 and len(replay) >= cfg.min_replay_size:
-                batches = replay.sample_stack(cfg.updates_per_call, cfg.batch_size)
+                batches = replay.sample_stack(cfg.updates_per_call, cfg.batch_size, relabeler,
+                                              cfg.her_ratio, cfg.relabel_rewards)
                 self.latest_metrics = self.learner.step(batches)
                 self.actor.update(self.learner.policy_params)
             if timestep.last():
+                replay.end_episode()
                 self.episodes += 1
                 if on_episode is not None:
                     position_error, attitude_error = probes.head_errors(env)

@@ -105,7 +105,9 @@ def log_training_curves(path: str, runs: Dict[str, List[dict]], evals: Dict[str,
         if not records:
             continue
         steps = np.array([r["env_steps"] for r in records], np.int64)
-        for field in ("success_rate", "position_error_median", "attitude_error_median"):
+        for field in ("success_rate", "position_error_median", "attitude_error_median", "return_mean"):
+            if field not in records[0]["summary"]:  # no errors on e.g. reacher; returns only
+                continue
             values = np.array([r["summary"][field] for r in records], np.float64)
             rec.send_columns(f"heldout/{field}/{label}", indexes=[rr.TimeColumn("env_steps", sequence=steps)],
                              columns=rr.Scalars.columns(scalars=values))

@@ -6,7 +6,8 @@
 Run directory:
     config.json                  the command line and resolved configuration
     curriculum/, baseline/       checkpoint.pkl, metrics.jsonl (one line per episode), evals.jsonl
-    evaluation/                  <label>_heldout.json, <label>_track.json, <label>_track.rrd
+    evaluation/                  <label>_heldout.json, <label>_heldout_moving.json, <label>_track.json,
+                                 <label>_track.rrd; labels curriculum, baseline and (on the arm) lookup
     figures/                     learning_curves.png, track.png
     training.rrd                 training curves of both runs
     summary.json
@@ -63,6 +64,16 @@ class Progress:
             self.bar.close()
 
 
+def positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive number of steps, got {value}")
+    return value
+
+
 def build_parser():
     p = argparse.ArgumentParser(description="Train curriculum SAC (and a plain-SAC baseline) on the Robostrich arm.")
     p.add_argument("--out", default="runs/default", help="run directory")
@@ -74,7 +85,8 @@ def build_parser():
     p.add_argument("--plan", default=None,
                    help="explicit plan '[domain/]task:steps,...' (overrides --steps/--lessons)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--checkpoint-every", type=int, default=25_000)
+    p.add_argument("--checkpoint-every", type=positive_int, default=25_000,
+                   help="environment steps between checkpoints (default: %(default)s)")
     p.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
                    help="also train plain SAC on the final lesson with the same total budget")
     p.add_argument("--eval-every", type=int, default=None, help="held-out evaluation period (default: steps/6)")
@@ -103,6 +115,14 @@ def build_parser():
     g.add_argument("--env-steps-per-call", type=int, default=8,
                    help="agent steps between learner calls; update-to-data ratio = updates-per-call / this")
     g.add_argument("--action-repeat", type=int, default=5, help="control steps per agent decision")
+    g.add_argument("--reward-scale", type=float, default=1.0, help="multiplies rewards in the critic's target")
+    g.add_argument("--target-entropy", type=float, default=None, help="temperature target (default: -|A|)")
+    g.add_argument("--critic-layer-norm", action=argparse.BooleanOptionalAction, default=False,
+                   help="LayerNorm in the critics' hidden layers")
+    g.add_argument("--her-ratio", type=float, default=0.0,
+                   help="share of each batch relabelled with a goal reached later in the episode (HER)")
+    g.add_argument("--relabel-rewards", action=argparse.BooleanOptionalAction, default=False,
+                   help="recompute sampled rewards with the current lesson's reward function")
     return p
 
 
@@ -112,7 +132,10 @@ def config_from_args(args) -> SACConfig:
                      hidden_sizes=tuple(int(h) for h in args.hidden.split(",") if h),
                      min_replay_size=args.min_replay, max_replay_size=args.replay_size,
                      updates_per_call=args.updates_per_call, env_steps_per_call=args.env_steps_per_call,
-                     action_repeat=args.action_repeat)
+                     action_repeat=args.action_repeat, reward_scale=args.reward_scale,
+                     target_entropy=args.target_entropy,
+                     critic_layer_norm=args.critic_layer_norm, her_ratio=args.her_ratio,
+                     relabel_rewards=args.relabel_rewards)
 
 
 def plan_from_args(args):
@@ -143,15 +166,24 @@ def main(argv=None):
     run_plans = {"curriculum": plan}
     if args.baseline:
         run_plans["baseline"] = [Lesson(final.domain, final.task, total)]
+    existing = [l for l in run_plans if os.path.exists(os.path.join(args.out, l, "checkpoint.pkl"))]
+    if not args.resume and existing:
+        raise ValueError(f"{args.out} already holds checkpoints ({', '.join(existing)}); "
+                         "pass --resume to continue them or choose another --out")
+    if args.resume and not existing:  # a typo in --out must not quietly start the whole job afresh
+        looked = ", ".join(os.path.join(l, "checkpoint.pkl") for l in run_plans)
+        where = (f"{args.out} holds no checkpoint ({looked})" if os.path.isdir(args.out)
+                 else f"{args.out} does not exist")
+        raise FileNotFoundError(f"--resume: nothing to resume: {where}; check --out, or leave out --resume "
+                                "to start a fresh run")
+    if args.resume:  # damaged or another configuration: refuse before building anything or touching a file
+        from agents import checkpoint
+        for label in existing:
+            path = os.path.join(args.out, label, "checkpoint.pkl")
+            expected = {"config": config.to_dict(), "plan": format_plan(run_plans[label]), "seed": args.seed}
+            stored = checkpoint.read_fingerprint(path)
+            checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
     os.makedirs(args.out, exist_ok=True)
-    if not args.resume:
-        existing = [l for l in run_plans if os.path.exists(os.path.join(args.out, l, "checkpoint.pkl"))]
-        if existing:
-            raise ValueError(f"{args.out} already holds checkpoints ({', '.join(existing)}); "
-                             "pass --resume to continue them or choose another --out")
-    evaluation.write_json(os.path.join(args.out, "config.json"), {
-        "argv": sys.argv if argv is None else list(argv), "config": config.to_dict(),
-        "plans": {k: format_plan(v) for k, v in run_plans.items()}, "seed": args.seed})
 
     boundaries = list(np.cumsum([l.steps for l in plan]))
     eval_every = args.eval_every or max(1, total // 6)
@@ -163,11 +195,16 @@ def main(argv=None):
                             checkpoint_every=args.checkpoint_every, name=label)
         if args.resume and os.path.exists(run.checkpoint_path):
             run.restore()  # raises on damaged/mismatched checkpoints, never restarts silently
-        elif os.path.exists(run.metrics_path) or os.path.exists(run.evals_path):
+        runs[label] = run
+    # Every checkpoint is restored: only now change the run directory (a rejected resume leaves it as it was).
+    for run in runs.values():
+        if not (args.resume and os.path.exists(run.checkpoint_path)):
             for p in (run.metrics_path, run.evals_path):  # a run that died before its first checkpoint
                 if os.path.exists(p):
                     os.unlink(p)
-        runs[label] = run
+    evaluation.write_json(os.path.join(args.out, "config.json"), {
+        "argv": sys.argv if argv is None else list(argv), "config": config.to_dict(),
+        "plans": {k: format_plan(v) for k, v in run_plans.items()}, "seed": args.seed})
 
     progress = Progress(sum(r.total_steps for r in runs.values()), enabled=not args.quiet)
     progress.bar and progress.bar.update(sum(r.loop.env_steps for r in runs.values()))
@@ -202,13 +239,18 @@ def main(argv=None):
                                                   (None if domain in ROBOSTRICH_DOMAINS else args.num_eval_targets),
                                                   env_steps=run.loop.env_steps, record=not args.no_rerun,
                                                   action_repeat=config.action_repeat)
+    lookup = evaluation.evaluate_lookup(out_eval, domain, heldout_task, track_task, args.final_eval_targets,
+                                        record=not args.no_rerun)
+    if lookup is not None:  # the no-learning bar, beside the agents
+        finals["lookup"] = lookup
     metrics = {label: read_jsonl(run.metrics_path) for label, run in runs.items()}
     evals = {label: read_jsonl(run.evals_path) for label, run in runs.items()}
     if not args.no_figures:
         from agents import figures
         os.makedirs(os.path.join(args.out, "figures"), exist_ok=True)
         figures.plot_learning_curves(metrics, evals, os.path.join(args.out, "figures", "learning_curves.png"),
-                                     lesson_boundaries=boundaries[:-1])
+                                     lesson_boundaries=boundaries[:-1],
+                                     baselines={"lookup": lookup["heldout"]["summary"]} if lookup else None)
         if track_task:
             figures.plot_track({l: f["track"] for l, f in finals.items()},
                                os.path.join(args.out, "figures", "track.png"))
@@ -224,5 +266,11 @@ def main(argv=None):
     return summary
 
 
+def cli(argv=None) -> int:
+    """Console script `robostrich-train`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
+    from robostrich_suite import cli as cli_lib
+    return cli_lib.run(main, "robostrich-train", argv)
+
+
 if __name__ == "__main__":
-    main()
+    sys.exit(cli())

@@ -429,10 +429,43 @@ def head_axis(physics) -> np.ndarray:
     return np.array(physics.data.xmat[body_id]).reshape(3, 3)[:, 2]
 
 
+def continuous_attitude_deg(axis_angle_deg, joint_angles_rad):
+    """Head attitude (deg) continuous over every pose the arm can take.
+
+    ``axis_angle_deg`` is the head axis' angle from the vertical as ``atan2``
+    gives it, in (-180, 180]; it jumps by 360 deg when the head passes
+    straight down, while Table 1's limits let the joints sum from -409 to
+    +292 deg.  In a planar chain of parallel hinges the attitude is the base's
+    attitude plus the sum of the joint angles; the base (a frame or a
+    quadruped's trunk) never turns by 180 deg, so taking the ``atan2`` value
+    360k away that lies nearest the joint sum gives one continuous attitude.
+    Works on scalars and on arrays ((n,) angles with (n, joints) joints).
+    """
+    summed = np.degrees(np.sum(joint_angles_rad, axis=-1))
+    return axis_angle_deg + 360.0 * np.round((summed - axis_angle_deg) / 360.0)
+
+
+def attitude_error_deg(attitude_deg, desired_deg):
+    """How far the head is turned from ``desired_deg``, in [-180, 180) deg.
+
+    The attitude itself is continuous and can differ from level by more than a
+    turn (a neck curled back by -270 deg holds the head level, facing forward,
+    as at +90); the error is about where the head points, so it is taken
+    modulo a turn.  Its magnitude is continuous everywhere, so are rewards on it.
+    """
+    return (np.asarray(attitude_deg) - desired_deg + 180.0) % 360.0 - 180.0
+
+
 def head_attitude_deg(physics) -> float:
-    """Head attitude in the world's x-z plane: 0 up, 90 level (paper Fig. 2B), 180 down."""
+    """Head attitude in the world's x-z plane: 0 up, 90 level (paper Fig. 2B), 180 down,
+    continuous past 180 (see :func:`continuous_attitude_deg`)."""
     axis = head_axis(physics)
-    return float(np.degrees(np.arctan2(axis[0], axis[2])))
+    model = physics.model
+    prefix = ARM_MODEL_NAME + "/"
+    qpos_adr = [model.jnt_qposadr[i] for i in range(model.njnt)
+                if model.jnt_type[i] == 3 and model.id2name(i, "joint").startswith(prefix)]
+    return float(continuous_attitude_deg(float(np.degrees(np.arctan2(axis[0], axis[2]))),
+                                         physics.data.qpos[qpos_adr]))
 
 
 def reach(spec: ArmSpec) -> float:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import logging
 
+import mujoco as mujoco_lib
 import numpy as np
 from dm_control.rl import control
 
@@ -62,9 +63,11 @@ class ArmPhysicsMixin:
         return self.data.sensordata[adr:adr + 3].copy()
 
     def head_attitude(self) -> float:
-        """Head attitude in degrees: 90 = head parallel to the ground (paper Fig. 2B)."""
+        """Head attitude in degrees: 90 = head parallel to the ground (paper Fig. 2B); continuous
+        past 180 (no wrap), see :func:`arm.continuous_attitude_deg`."""
         xmat = self.data.xmat[self._arm_indices()[5]]  # row-major 3x3; column 2 = head axis
-        return float(np.degrees(np.arctan2(xmat[2], xmat[8])))
+        return float(arm_lib.continuous_attitude_deg(np.degrees(np.arctan2(xmat[2], xmat[8])),
+                                                     self.data.qpos[self._arm_indices()[0]]))
 
     def joint_angles(self) -> np.ndarray:
         """The 18 joint angles (rad), atlas first; positive = ventral flexion."""
@@ -118,6 +121,14 @@ class ArmPhysicsMixin:
                 self.divergence = "non-finite joint state"
         if self.divergence is not None:
             logging.warning("physics diverged, ending the episode: %s", self.divergence)
+
+    def __setstate__(self, state):
+        super().__setstate__(state)
+        # dm_control's Euler step ends each step with mj_step1 and begins the next with
+        # mj_step2, which reuses what mj_step1 computed (constraint rows among it). A
+        # pickled MjData keeps the state but not those, so recompute them: an unpickled
+        # environment (a resumed training run) then continues bit-exactly.
+        mujoco_lib.mj_step1(self.model.ptr, self.data.ptr)
 
     def reset(self, keyframe_id=None):
         self.divergence = None

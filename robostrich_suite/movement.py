@@ -621,5 +621,12 @@ def main(argv=None) -> dict:
     return results
 
 
+def cli(argv=None) -> int:
+    """Console script `robostrich-movement`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
+    from robostrich_suite import cli as cli_lib
+    return cli_lib.run(main, "robostrich-movement", argv)
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+    sys.exit(cli())

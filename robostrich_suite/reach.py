@@ -24,6 +24,7 @@ import numpy as np
 from dm_control.suite import base
 from dm_env import specs
 
+from robostrich_suite import arm as arm_lib
 from robostrich_suite import randomization as randomization_lib
 from robostrich_suite import rewards
 
@@ -141,12 +142,31 @@ class Reach(base.Task):
         return float(np.linalg.norm(self.target_position - self.head_xz(physics)))
 
     def attitude_error(self, physics) -> float:
-        """Signed head attitude error in degrees (positive = head pitched down)."""
-        return physics.head_attitude() - self.desired_attitude
+        """Signed head attitude error in degrees (positive = head pitched down), in [-180, 180)."""
+        return float(arm_lib.attitude_error_deg(physics.head_attitude(), self.desired_attitude))
 
     def is_success(self, physics) -> bool:
         return (self.position_error(physics) <= self.position_tolerance
                 and abs(self.attitude_error(physics)) <= self.attitude_tolerance)
+
+    # --- hindsight goals ------------------------------------------------------
+    # The observation keys an agent needs to put another goal into an observation
+    # (agents/goals.py): the goal, the achieved position it is compared with, and
+    # their difference.
+    GOAL_OBSERVATION = "target_position"
+    ACHIEVED_OBSERVATION = "head_position"
+    GOAL_DELTA_OBSERVATION = "to_target"
+    ATTITUDE_ERROR_OBSERVATION = "attitude_error"  # rad
+
+    def goal_reward(self, achieved, attitude_error_deg, goal) -> np.ndarray:
+        """The reward this task gives with the head at ``achieved`` (..., 2), its attitude
+        ``attitude_error_deg`` (...) off, had the target been ``goal`` (..., 2): eqs. 9-10
+        on arrays, equal to :meth:`get_reward` for the real target (no divergence)."""
+        error = np.linalg.norm(np.asarray(goal) - np.asarray(achieved), axis=-1)
+        if self.reward_name == "lesson1":
+            return rewards.lesson1_rewards(error, self.position_tolerance)
+        return rewards.lesson2_rewards(error, attitude_error_deg, self.position_tolerance,
+                                       self.attitude_tolerance, self.weights)
 
     # --- dm_control Task API ------------------------------------------------
     def get_observation(self, physics):

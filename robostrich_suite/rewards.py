@@ -1,7 +1,13 @@
-"""The curriculum's reward functions (paper eqs. 9 and 10), as plain functions."""
+"""The curriculum's reward functions (paper eqs. 9 and 10), as plain functions.
+
+The ``*_rewards`` variants take arrays: the agent recomputes rewards for
+relabelled goals (hindsight) with them, exactly as the task would have given.
+"""
 from __future__ import annotations
 
 import dataclasses
+
+import numpy as np
 
 
 @dataclasses.dataclass(frozen=True)
@@ -33,3 +39,19 @@ def lesson2_reward(position_error: float, attitude_error_deg: float, position_to
             - weights.attitude_miss * float(attitude_error_deg > attitude_tolerance_deg))
     r_a2 = -weights.position_error * position_error - weights.attitude_error * attitude_error_deg
     return r_m2 + r_a2
+
+
+def lesson1_rewards(position_error, position_tolerance: float) -> np.ndarray:
+    """Eq. 9 on arrays of position errors."""
+    return -(np.asarray(position_error) > position_tolerance).astype(np.float64)
+
+
+def lesson2_rewards(position_error, attitude_error_deg, position_tolerance: float,
+                    attitude_tolerance_deg: float, weights: RewardWeights = RewardWeights()
+                    ) -> np.ndarray:
+    """Eq. 10 on arrays of position and attitude errors (same result as ``lesson2_reward``)."""
+    position_error = np.asarray(position_error, np.float64)
+    attitude_error_deg = np.abs(np.asarray(attitude_error_deg, np.float64))
+    return (-weights.position_miss * (position_error > position_tolerance)
+            - weights.attitude_miss * (attitude_error_deg > attitude_tolerance_deg)
+            - weights.position_error * position_error - weights.attitude_error * attitude_error_deg)

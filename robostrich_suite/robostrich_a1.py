@@ -243,7 +243,9 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
         """Head attitude (deg) in the trunk's heading plane: 0 up, 90 level, 180 down."""
         xmat = self.data.xmat[self._arm_indices()[5]]  # head body; row-major: axis z = (2, 5, 8)
         hx, hy = self.heading()
-        return math.degrees(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8]))
+        return float(arm_lib.continuous_attitude_deg(
+            math.degrees(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8])),
+            self.data.qpos[self._arm_indices()[0]]))
 
     # Quadruped.
     def trunk_position(self) -> np.ndarray:

@@ -159,5 +159,12 @@ def main(argv=None) -> None:
     print(f"wrote {png}")
 
 
+def cli(argv=None) -> int:
+    """Console script `robostrich-walk`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
+    from robostrich_suite import cli as cli_lib
+    return cli_lib.run(main, "robostrich-walk", argv)
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+    sys.exit(cli())

@@ -97,7 +97,7 @@ class KinematicSamples:
 
     def level(self, tolerance_deg: float = LEVEL_TOLERANCE_DEG) -> np.ndarray:
         """Mask of the paper's blue region: head attitude 90 +- tolerance deg."""
-        return np.abs(self.head_attitude - LEVEL_ATTITUDE_DEG) <= tolerance_deg
+        return np.abs(arm_lib.attitude_error_deg(self.head_attitude, LEVEL_ATTITUDE_DEG)) <= tolerance_deg
 
 
 EDGE_SPREAD = 0.1  # per-joint spread of an edge sample around its segment's limit fraction
@@ -154,7 +154,7 @@ def kinematic_samples(num_samples: int, seed: int = 0, spec: arm_lib.ArmSpec | N
         mujoco.mj_kinematics(model, data)
         positions[i] = data.site_xpos[site, [0, 2]]
         axes[i] = data.xmat[head_body, [2, 8]]  # head z axis: world x and z components
-    attitudes = np.degrees(np.arctan2(axes[:, 0], axes[:, 1]))
+    attitudes = arm_lib.continuous_attitude_deg(np.degrees(np.arctan2(axes[:, 0], axes[:, 1])), angles)
     uniform = np.arange(total) < num_samples
     return KinematicSamples(angles, positions, attitudes, uniform)
 
@@ -172,7 +172,8 @@ class ActuatedSamples:
 
     def level(self, tolerance_deg: float = LEVEL_TOLERANCE_DEG) -> np.ndarray:
         """Mask of settled poses with the head level (90 +- tolerance deg)."""
-        return self.settled & (np.abs(self.head_attitude - LEVEL_ATTITUDE_DEG) <= tolerance_deg)
+        return self.settled & (np.abs(arm_lib.attitude_error_deg(self.head_attitude, LEVEL_ATTITUDE_DEG))
+                                <= tolerance_deg)
 
     @classmethod
     def concatenate(cls, parts) -> "ActuatedSamples":
@@ -207,7 +208,7 @@ def seek_level(physics: mjcf.Physics, control: np.ndarray, seek_time: float) -> 
     physics.reset()
     physics.data.ctrl[:] = control
     for _ in range(int(round(seek_time / dt))):
-        error = (head_attitude_deg(physics) - LEVEL_ATTITUDE_DEG + 180.0) % 360.0 - 180.0
+        error = float(arm_lib.attitude_error_deg(head_attitude_deg(physics), LEVEL_ATTITUDE_DEG))
         control[0] = np.clip(control[0] + LEVEL_SEEK_GAIN * error * dt, low, high)
         physics.data.ctrl[0] = control[0]
         physics.step()
@@ -397,5 +398,12 @@ def main(argv=None) -> dict:
     return {"figure": figure, "samples": samples}
 
 
+def cli(argv=None) -> int:
+    """Console script `robostrich-workspace`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
+    from robostrich_suite import cli as cli_lib
+    return cli_lib.run(main, "robostrich-workspace", argv)
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+    sys.exit(cli())

@@ -56,5 +56,12 @@ def main(argv=None) -> None:
         print(f"wrote {path}")
 
 
+def cli(argv=None) -> int:
+    """Console script `robostrich-export-xml`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
+    from robostrich_suite import cli as cli_lib
+    return cli_lib.run(main, "robostrich-export-xml", argv)
+
+
 if __name__ == "__main__":
-    main()
+    import sys
+    sys.exit(cli())

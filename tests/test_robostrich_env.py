@@ -207,3 +207,50 @@ def test_default_track_targets_are_held_out_level_poses():
     assert len(env.task.targets) == 3
     for target in env.task.targets:
         assert np.min(np.linalg.norm(held_out - target, axis=1)) == 0.0
+
+
+@pytest.mark.parametrize("bend_deg", [9.0, 10.5, 11.5, 13.0, -12.0, -16.0, -20.0])
+def test_head_attitude_is_continuous_past_180_degrees(bend_deg):
+    """The attitude is the sum of the joint angles, also where atan2 would wrap (issue: lesson-2
+    reward jumped at +-180 deg): 18 joints at 11.5 deg put the head at 207 deg, not -153.
+    At -20 deg per joint (-360) the head points up again: attitude error -90, as at 0."""
+    env = _pose_env("lesson2", [0.3, 0.4])
+    physics, task = env.physics, env.task
+    _bend(physics, np.radians(bend_deg))
+    assert physics.head_attitude() == pytest.approx(18 * bend_deg, abs=1e-6)
+    # The error is where the head points: modulo a turn, in [-180, 180).
+    assert task.attitude_error(physics) == pytest.approx((18 * bend_deg - 90 + 180) % 360 - 180, abs=1e-6)
+    obs = task.get_observation(physics)
+    assert obs["head_attitude"][0] == pytest.approx(np.radians(18 * bend_deg), abs=1e-8)
+
+
+def test_attitude_error_and_reward_have_no_jump_under_bang_bang_inputs():
+    """Bang-bang tendon inputs swing the head through 180 deg; per control step the attitude
+    can change only by what the joints moved, so the attitude never jumps by ~360 deg, and
+    neither does the attitude part of the reward."""
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=1, time_limit=40.0))
+    rng = np.random.default_rng(0)
+    spec = env.action_spec()
+    env.reset()
+    physics = env.physics
+    previous = physics.head_attitude()
+    largest_step = 0.0
+    crossed = False
+    for step in range(1500):
+        if step % 60 == 0:
+            action = np.where(rng.random(9) < 0.5, spec.minimum, spec.maximum)
+            action[0] = spec.minimum[0]  # dorsal slack: ventral pulls curl the head down and back
+        timestep = env.step(action)
+        attitude = physics.head_attitude()
+        joint_sum = np.degrees(physics.joint_angles().sum())
+        assert attitude == pytest.approx(joint_sum, abs=1e-6)
+        largest_step = max(largest_step, abs(attitude - previous))
+        miss = abs(env.task.attitude_error(physics))
+        assert miss <= 180.0 and miss == pytest.approx(
+            min(abs(attitude - 90) % 360, 360 - abs(attitude - 90) % 360), abs=1e-6)
+        crossed |= attitude > 180.0
+        previous = attitude
+        if timestep.last():
+            break
+    assert largest_step < 60.0
+    assert crossed, "the inputs should swing the head past 180 deg (straight down)"

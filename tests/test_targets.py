@@ -16,7 +16,7 @@ def test_pose_set_was_made_with_the_current_arm():
 def test_poses_are_level_and_split_without_overlap():
     poses = targets.level_head_poses()
     assert len(poses["head_position"]) >= 50
-    assert np.all(np.abs(poses["head_attitude"] - 90) <= 5)
+    assert np.all(np.abs(arm.attitude_error_deg(poses["head_attitude"], 90)) <= 5)
     train, held_out = targets.training_targets(), targets.heldout_targets()
     assert len(train) >= 60 and len(held_out) >= 15
     distances = np.linalg.norm(train[:, None] - held_out[None], axis=2)
@@ -32,7 +32,7 @@ def test_stored_inputs_really_hold_the_head_level_there(index):
     assert workspace.settle(physics, poses["control"][index])
     np.testing.assert_allclose(workspace.head_position_xz(physics),
                                poses["head_position"][index], atol=1e-6)
-    assert abs(workspace.head_attitude_deg(physics) - 90) <= 5
+    assert abs(arm.attitude_error_deg(workspace.head_attitude_deg(physics), 90)) <= 5
 
 
 def test_another_arm_gets_a_warning_and_its_own_targets(tmp_path):
@@ -50,7 +50,7 @@ def test_another_arm_gets_a_warning_and_its_own_targets(tmp_path):
     with np.load(path) as data:
         assert str(data["fingerprint"]) == workspace.model_fingerprint(None, slips)
         assert len(data["head_position"]) == count > 0
-        assert np.all(np.abs(data["head_attitude"] - 90) <= 5)
+        assert np.all(np.abs(arm.attitude_error_deg(data["head_attitude"], 90)) <= 5)
     pool = np.concatenate([targets.training_targets(path), targets.heldout_targets(path)])
     assert len(pool) >= 1
     with warnings.catch_warnings():

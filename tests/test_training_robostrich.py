@@ -12,10 +12,14 @@ from agents.curriculum import CurriculumRun, parse_plan  # noqa: E402
 from agents.sac.builder import SACBuilder  # noqa: E402
 from agents.sac.config import SACConfig  # noqa: E402
 
-# Small but real: lesson 1 (eq. 9, position only) on the default arm and target set.
-CONFIG = SACConfig(batch_size=64, hidden_sizes=(64, 64), learning_rate=1e-3, init_temperature=0.1,
-                   min_replay_size=1000, max_replay_size=20_000, updates_per_call=4, env_steps_per_call=4)
-STEPS = 24_000  # measured here: success 0 -> 5/27 held-out targets, median error 0.43 -> 0.11 m
+# Small but real: lesson 1 (eq. 9, position only) on the default arm and target set, with the
+# agent's improvements on (hindsight relabelling, layer-normed critics, a low initial temperature).
+CONFIG = SACConfig(batch_size=64, hidden_sizes=(64, 64), learning_rate=1e-3, init_temperature=0.01,
+                   min_replay_size=1000, max_replay_size=30_000, updates_per_call=4, env_steps_per_call=4,
+                   her_ratio=0.5, relabel_rewards=True, critic_layer_norm=True)
+# Measured here at 24k steps: success 0 -> 11/27 held-out targets, median error 0.43 -> 0.068 m
+# (the same run without those improvements: 2/27, 0.18 m).
+STEPS = 24_000
 
 
 def position_report(run):
@@ -31,8 +35,8 @@ def test_short_lesson1_training_improves_success_on_heldout_targets(tmp_path):
     untrained_success, untrained_error = position_report(run)
     run.run()
     trained_success, trained_error = position_report(run)
-    assert trained_error < 0.5 * untrained_error, (untrained_error, trained_error)
-    assert trained_success >= untrained_success + 0.1, (untrained_success, trained_success)
+    assert trained_error < 0.3 * untrained_error, (untrained_error, trained_error)
+    assert trained_success >= untrained_success + 0.25, (untrained_success, trained_success)
 
 
 def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them(tmp_path):
@@ -44,22 +48,30 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
     for name in ("config.json", "summary.json", "training.rrd", "figures/learning_curves.png", "figures/track.png",
                  "curriculum/checkpoint.pkl", "baseline/checkpoint.pkl", "curriculum/metrics.jsonl",
                  "evaluation/curriculum_heldout.json", "evaluation/baseline_track.json",
-                 "evaluation/curriculum_track.rrd"):
+                 "evaluation/curriculum_track.rrd", "evaluation/lookup_heldout.json",
+                 "evaluation/baseline_heldout_moving.json", "evaluation/lookup_track.json"):
         assert os.path.getsize(os.path.join(out, name)) > 0, name
     track = json.load(open(os.path.join(out, "evaluation", "curriculum_track.json")))
     assert len(track["segments"]) == 3  # three targets in order (Fig. 7)
     assert len(track["series"]["time"]) == 3 * 250
     heldout = json.load(open(os.path.join(out, "evaluation", "curriculum_heldout.json")))
     assert heldout["summary"]["episodes"] == 2 and 0.0 <= heldout["summary"]["success_rate"] <= 1.0
+    summary = json.load(open(os.path.join(out, "summary.json")))["runs"]
+    assert set(summary) == {"curriculum", "baseline", "lookup"}  # the no-learning bar beside the agents
+    for label in summary:
+        assert set(summary[label]) == {"heldout", "heldout_moving", "track"}
+        assert summary[label]["heldout_moving"]["episodes"] == 2 * 3  # each held-out target from three starts
+    assert summary["lookup"]["heldout"]["success_rate"] == 1.0  # the first two held-out targets
     evals = [json.loads(l) for l in open(os.path.join(out, "curriculum", "evals.jsonl"))]
     assert [e["env_steps"] for e in evals] == [125, 250, 375, 500, 625, 750]
     # the baseline has the same total budget, on the final lesson alone
     baseline = json.load(open(os.path.join(out, "config.json")))["plans"]["baseline"]
     assert baseline == "robostrich/lesson3:750"
     reports = evaluation.main([os.path.join(out, "curriculum", "checkpoint.pkl"), "--out", str(tmp_path / "ev"),
-                               "--num-targets", "2", "--no-rerun"])
-    assert reports["heldout"]["summary"] == heldout["summary"]  # deterministic policy, same targets
-    assert reports["track"]["summary"] == track["summary"]
+                               "--num-targets", "2", "--no-rerun", "--label", "curriculum"])
+    for label in ("curriculum", "lookup"):  # deterministic policies, same targets
+        assert {k: r["summary"] for k, r in reports[label].items()} == summary[label]
+    assert reports["curriculum"]["track"]["summary"] == track["summary"]
     rerun = os.path.join(os.path.dirname(os.sys.executable), "rerun")
     if os.path.exists(rerun):
         import subprocess

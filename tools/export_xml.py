@@ -1,5 +1,7 @@
 """Regenerate xml/ from the MJCF generators: python tools/export_xml.py [--out DIR]."""
-from robostrich_suite.xml_export import main
+import sys
+
+from robostrich_suite.xml_export import cli
 
 if __name__ == "__main__":
-    main()
+    sys.exit(cli())

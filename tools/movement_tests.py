@@ -9,4 +9,4 @@ except ImportError:  # run from a checkout without `pip install -e .`
     from robostrich_suite import movement
 
 if __name__ == "__main__":
-    movement.main()
+    sys.exit(movement.cli())

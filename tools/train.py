@@ -4,7 +4,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from agents.training import main  # noqa: E402
+from agents.training import cli  # noqa: E402
 
 if __name__ == "__main__":
-    main()
+    sys.exit(cli())

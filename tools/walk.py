@@ -4,10 +4,11 @@ Writes a Rerun recording (OUT.rrd, open with `rerun OUT.rrd`) and a PNG of the
 trunk's and head's height, speed and attitude over time.
 """
 import os
+import sys
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-from robostrich_suite.walk import main  # noqa: E402
+from robostrich_suite.walk import cli  # noqa: E402
 
 if __name__ == "__main__":
-    main()
+    sys.exit(cli())

@@ -9,4 +9,4 @@ except ImportError:  # run from a checkout without `pip install -e .`
     from robostrich_suite import workspace
 
 if __name__ == "__main__":
-    workspace.main()
+    sys.exit(workspace.cli())

@@ -2,6 +2,7 @@
 import jax
 
 from agents.actors import ActionAdapter, Actor
+from agents.goals import GoalRelabeler
 from agents.loop import EnvironmentLoop
 from agents.replay import ObservationFlattener, ReplayBuffer
 from agents.sac.config import SACConfig
@@ -26,11 +27,15 @@ class SACBuilder:
             raise ValueError(f"expected a flat action spec, got shape {action_spec.shape}")
         flattener = ObservationFlattener(env.observation_spec())
         adapter = ActionAdapter(action_spec)
-        networks = make_networks(flattener.size, adapter.size, cfg.hidden_sizes, cfg.log_std_min, cfg.log_std_max)
+        networks = make_networks(flattener.size, adapter.size, cfg.hidden_sizes, cfg.log_std_min, cfg.log_std_max,
+                                 cfg.critic_layer_norm)
         key = jax.random.PRNGKey(seed)
         learner_key, actor_key = jax.random.split(key)
         learner = SACLearner(networks, cfg, learner_key)
-        replay = ReplayBuffer(flattener.size, adapter.size, cfg.max_replay_size, seed=seed)
+        relabeler = GoalRelabeler.for_environment(env, flattener) if cfg.uses_goals else None
+        goal_width = relabeler.goal_size + 1 if relabeler is not None else 0  # + attitude error
+        replay = ReplayBuffer(flattener.size, adapter.size, cfg.max_replay_size, seed=seed,
+                              goal_width=goal_width, repeat=cfg.action_repeat)
         actor = Actor(networks, adapter, learner.policy_params, key=actor_key, deterministic=False)
         loop = EnvironmentLoop(env, actor, replay, learner, cfg, flattener, seed=seed)
         return loop

@@ -30,12 +30,24 @@ class SACConfig:
     reward_scale: float = 1.0
     log_std_min: float = -5.0
     log_std_max: float = 2.0
+    # Agent improvements beyond the paper's SAC; the defaults (off) are plain SAC.
+    critic_layer_norm: bool = False  # LayerNorm in every hidden layer of both critics
+    # Hindsight relabelling (HER, "future" strategy) on tasks whose reward is a function of the
+    # achieved head pose and the goal (robostrich's Reach): this fraction of every sampled batch
+    # gets a goal the head reached later in the same episode, with the reward recomputed exactly.
+    her_ratio: float = 0.0
+    # Recompute every sampled transition's reward with the current lesson's reward function
+    # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
+    # replay then carry lesson-2 rewards instead of the ones they were collected with.
+    relabel_rewards: bool = False
 
     def __post_init__(self):
         if min(self.batch_size, self.updates_per_call, self.env_steps_per_call, self.action_repeat) <= 0:
             raise ValueError("batch_size, updates_per_call, env_steps_per_call and action_repeat must be positive")
         if not 0.0 < self.tau <= 1.0:
             raise ValueError(f"tau must be in (0, 1], got {self.tau}")
+        if not 0.0 <= self.her_ratio <= 1.0:
+            raise ValueError(f"her_ratio must be in [0, 1], got {self.her_ratio}")
         if self.min_replay_size > self.max_replay_size:
             raise ValueError("min_replay_size exceeds max_replay_size")
         object.__setattr__(self, "hidden_sizes", tuple(int(h) for h in self.hidden_sizes))
@@ -51,6 +63,11 @@ class SACConfig:
         d = dataclasses.asdict(self)
         d["hidden_sizes"] = list(self.hidden_sizes)
         return d
+
+    @property
+    def uses_goals(self) -> bool:
+        """Whether the replay must keep achieved goals (for HER or reward recomputation)."""
+        return self.her_ratio > 0.0 or self.relabel_rewards
 
     @classmethod
     def from_dict(cls, d: dict) -> "SACConfig":

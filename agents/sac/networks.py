@@ -47,14 +47,30 @@ def tanh_gaussian_log_prob(u, mean, log_std):
 
 
 def make_networks(obs_size: int, action_size: int, hidden_sizes: Sequence[int] = (256, 256),
-                  log_std_min: float = -5.0, log_std_max: float = 2.0) -> SACNetworks:
-    """Cached: equal arguments give the same object, so learners and actors share compiled functions."""
+                  log_std_min: float = -5.0, log_std_max: float = 2.0,
+                  critic_layer_norm: bool = False) -> SACNetworks:
+    """Cached: equal arguments give the same object, so learners and actors share compiled functions.
+
+    ``critic_layer_norm`` normalises each hidden layer of the critics (before the ReLU):
+    it keeps Q-values' gradients well scaled when returns are large and lets a critic
+    learn fast at one update per step (Ball et al. 2023, "RLPD").
+    """
     return _make_networks(int(obs_size), int(action_size), tuple(int(h) for h in hidden_sizes),
-                          float(log_std_min), float(log_std_max))
+                          float(log_std_min), float(log_std_max), bool(critic_layer_norm))
+
+
+def _normalised_critic(x, hidden_sizes, name: str):
+    """Linear -> LayerNorm -> ReLU per hidden layer, then a linear Q head."""
+    for i, size in enumerate(hidden_sizes):
+        x = hk.Linear(size, name=f"{name}_linear_{i}")(x)
+        x = hk.LayerNorm(axis=-1, create_scale=True, create_offset=True, name=f"{name}_norm_{i}")(x)
+        x = jax.nn.relu(x)
+    return hk.Linear(1, name=f"{name}_head")(x)
 
 
 @functools.lru_cache(maxsize=None)
-def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max) -> SACNetworks:
+def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max,
+                   critic_layer_norm=False) -> SACNetworks:
 
     def policy_fn(obs):
         h = hk.nets.MLP(hidden_sizes, activation=jax.nn.relu, activate_final=True, name="policy_torso")(obs)
@@ -66,8 +82,12 @@ def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max
 
     def q_fn(obs, action):
         x = jnp.concatenate([obs, action], axis=-1)
-        q1 = hk.nets.MLP(hidden_sizes + (1,), activation=jax.nn.relu, name="q1")(x)
-        q2 = hk.nets.MLP(hidden_sizes + (1,), activation=jax.nn.relu, name="q2")(x)
+        if critic_layer_norm:
+            q1 = _normalised_critic(x, hidden_sizes, "q1")
+            q2 = _normalised_critic(x, hidden_sizes, "q2")
+        else:  # haiku's MLP, as the checkpoints of earlier runs have it
+            q1 = hk.nets.MLP(hidden_sizes + (1,), activation=jax.nn.relu, name="q1")(x)
+            q2 = hk.nets.MLP(hidden_sizes + (1,), activation=jax.nn.relu, name="q2")(x)
         return q1[..., 0], q2[..., 0]
 
     policy = hk.without_apply_rng(hk.transform(policy_fn))

@@ -1,0 +1,70 @@
+"""Goals in flat observations: hindsight relabelling (HER) and reward recomputation.
+
+A goal-reaching task whose reward is a function of the achieved pose and the
+goal (robostrich's eqs. 9 and 10) lets the agent ask "what would this
+transition have earned had the target been g?" and get the exact answer. The
+task says where the goal sits in its observation (``GOAL_OBSERVATION``,
+``ACHIEVED_OBSERVATION``, ``GOAL_DELTA_OBSERVATION``,
+``ATTITUDE_ERROR_OBSERVATION``) and gives the reward with ``goal_reward``; the
+agent never looks at the arm itself.
+
+Under an action repeat a transition spans several control steps whose rewards
+are summed, so the replay keeps the achieved position and attitude error after
+each of them (``substep_goals``) and sums the recomputed rewards the same way.
+"""
+from typing import Optional
+
+import numpy as np
+
+
+class GoalRelabeler:
+    """Overwrites the goal of flat observations and recomputes the task's reward."""
+
+    def __init__(self, flattener, task):
+        slices = _slices(flattener)
+        self.goal = slices[task.GOAL_OBSERVATION]
+        self.achieved = slices[task.ACHIEVED_OBSERVATION]
+        self.delta = slices.get(task.GOAL_DELTA_OBSERVATION)
+        self.attitude = slices[task.ATTITUDE_ERROR_OBSERVATION]
+        self.goal_size = self.goal.stop - self.goal.start
+        self.reward_fn = task.goal_reward
+
+    @classmethod
+    def for_environment(cls, env, flattener) -> Optional["GoalRelabeler"]:
+        """A relabeler for ``env``'s task, or None when the task has no goal reward."""
+        task = getattr(env, "task", None)
+        needed = ("goal_reward", "GOAL_OBSERVATION", "ACHIEVED_OBSERVATION", "ATTITUDE_ERROR_OBSERVATION")
+        if task is None or not all(hasattr(task, n) for n in needed) or flattener.keys is None:
+            return None
+        slices = _slices(flattener)
+        goal, achieved = slices.get(task.GOAL_OBSERVATION), slices.get(task.ACHIEVED_OBSERVATION)
+        if goal is None or achieved is None or task.ATTITUDE_ERROR_OBSERVATION not in slices:
+            return None
+        if goal.stop - goal.start != achieved.stop - achieved.start:
+            return None  # e.g. a 3-D head position against a 2-D target
+        return cls(flattener, task)
+
+    def substep(self, flat_obs: np.ndarray) -> np.ndarray:
+        """(achieved goal..., attitude error in deg) of one control step's flat observation."""
+        return np.concatenate([flat_obs[self.achieved], np.degrees(flat_obs[self.attitude])])
+
+    def with_goal(self, flat_obs: np.ndarray, goal: np.ndarray) -> np.ndarray:
+        """Copies of ``flat_obs`` (..., obs) with ``goal`` (..., g) as their target."""
+        out = flat_obs.copy()
+        out[..., self.goal] = goal
+        if self.delta is not None:
+            out[..., self.delta] = goal - flat_obs[..., self.achieved]
+        return out
+
+    def rewards(self, substep_goals: np.ndarray, substeps: np.ndarray, goal: np.ndarray) -> np.ndarray:
+        """Summed reward of transitions whose control steps reached ``substep_goals``
+        (..., k, g + 1) (only the first ``substeps`` (...) of the k count), for ``goal`` (..., g)."""
+        g = self.goal_size
+        per_step = self.reward_fn(substep_goals[..., :g], substep_goals[..., g], goal[..., None, :])
+        taken = np.arange(substep_goals.shape[-2]) < substeps[..., None]
+        return np.sum(np.where(taken, per_step, 0.0), axis=-1)
+
+
+def _slices(flattener) -> dict:
+    offsets = np.concatenate([[0], np.cumsum(flattener.sizes)])
+    return {k: slice(int(offsets[i]), int(offsets[i + 1])) for i, k in enumerate(flattener.keys)}

@@ -1,0 +1,152 @@
+"""tools/benchmark_seeds.py and tools/benchmark_dmc.py: aggregation exact, resume logic, tiny end-to-end runs."""
+import importlib.util
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import types
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TOOLS = os.path.join(ROOT, "tools")
+# The main job at its smallest: the final evaluation (3 labels, 1 held-out target) dominates its time.
+TINY_TRAINING = ["--plan", "lesson1:100,lesson2:100,lesson3:100", "--hidden", "16,16", "--batch-size", "16",
+                 "--min-replay", "20", "--num-eval-targets", "1", "--final-eval-targets", "1",
+                 "--eval-every", "1000000", "--quiet", "--no-rerun", "--no-figures"]
+
+
+def load_tool(name):
+    spec = importlib.util.spec_from_file_location(name, os.path.join(TOOLS, f"{name}.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def summary(success, position, attitude, steps=300, kinds=("heldout", "heldout_moving", "track")):
+    run = {k: {"success_rate": success, "position_error_median": position, "attitude_error_median": attitude}
+           for k in kinds}
+    return {"runs": {"curriculum": run, "baseline": dict(run), "lookup": dict(run)},
+            "env_steps": {"curriculum": steps, "baseline": steps}}
+
+
+@pytest.fixture(scope="session")
+def tool_env():
+    """XLA compiles dominate these tiny runs; a compilation cache that outlives the session makes reruns fast."""
+    cache = os.environ.get("JAX_COMPILATION_CACHE_DIR") or os.path.join(tempfile.gettempdir(),
+                                                                         "robostrich-tests-jax-cache")
+    return {**os.environ, "MUJOCO_GL": "egl", "JAX_COMPILATION_CACHE_DIR": cache,
+            "JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS": "0", "JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES": "-1"}
+
+
+def run_tool(name, *args, cwd, env):
+    proc = subprocess.run([sys.executable, os.path.join(TOOLS, f"{name}.py"), *args], cwd=cwd,
+                          capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return proc
+
+
+def test_seeds_aggregation_is_exact_mean_min_max():
+    tool = load_tool("benchmark_seeds")
+    summaries = [summary(0.0, 0.2, 10.0), summary(0.5, 0.4, 30.0), summary(0.25, 0.3, 5.0, kinds=("heldout",))]
+    agg = tool.aggregate(summaries, seeds=[0, 1, 7], minutes=[1.5, 2.5, None])
+    heldout = agg["results"]["curriculum"]["heldout"]
+    assert heldout["success_rate"] == {"mean": 0.25, "min": 0.0, "max": 0.5, "values": [0.0, 0.5, 0.25]}
+    assert heldout["position_error_median"]["mean"] == pytest.approx(0.3)
+    assert (heldout["position_error_median"]["min"], heldout["position_error_median"]["max"]) == (0.2, 0.4)
+    assert heldout["attitude_error_median"]["mean"] == pytest.approx(15.0)
+    assert (heldout["attitude_error_median"]["min"], heldout["attitude_error_median"]["max"]) == (5.0, 30.0)
+    track = agg["results"]["baseline"]["track"]  # the third seed has no track: averaged over the two that do
+    assert track["seeds"] == 2 and track["success_rate"]["mean"] == 0.25
+    assert list(agg["results"]) == ["curriculum", "baseline", "lookup"]
+    assert agg["steps"]["curriculum"] == [300, 300, 300] and agg["steps"]["lookup"] == [None] * 3
+    table = tool.format_table(agg)
+    assert "| curriculum | heldout | 25.0 [0.0, 50.0] | 0.300 [0.200, 0.400] | 15.0 [5.0, 30.0] |" in table
+    assert "| lookup | track (2/3 seeds) |" in table
+    assert "Seeds: 0, 1, 7" in table and "seed 1: 2.5, seed 7: -" in table and "curriculum 300" in table
+    with pytest.raises(ValueError, match="no summaries"):
+        tool.aggregate([])
+
+
+def test_seeds_passes_arguments_through_resumes_and_skips_finished_seeds(tmp_path, monkeypatch):
+    tool = load_tool("benchmark_seeds")
+    calls = []
+
+    def fake_main(argv):  # stands in for agents.training.main: records argv, writes a summary, returns a dict
+        calls.append(list(argv))
+        out = argv[argv.index("--out") + 1]
+        os.makedirs(out, exist_ok=True)
+        with open(os.path.join(out, "summary.json"), "w") as f:
+            json.dump(summary(1.0, 0.01, 1.0), f)
+        return {"not": "an exit code"}
+
+    import agents
+    fake = types.SimpleNamespace(main=fake_main)
+    monkeypatch.setitem(sys.modules, "agents.training", fake)
+    monkeypatch.setattr(agents, "training", fake, raising=False)
+    out = tmp_path / "seeds"
+    os.makedirs(out / "seed_1" / "baseline")
+    (out / "seed_1" / "baseline" / "checkpoint.pkl").write_bytes(b"")  # killed after a checkpoint
+    os.makedirs(out / "seed_2")
+    (out / "seed_2" / "summary.json").write_text(json.dumps(summary(0.0, 0.5, 50.0)))  # finished earlier
+    assert tool.main(["--seeds", "0,1,2", "--out", str(out), "--steps", "600", "--her-ratio", "0.5"]) == 0
+    assert calls == [["--steps", "600", "--her-ratio", "0.5", "--seed", "0", "--out", str(out / "seed_0")],
+                     ["--steps", "600", "--her-ratio", "0.5", "--seed", "1", "--out", str(out / "seed_1"),
+                      "--resume"]]
+    agg = json.loads((out / "seeds.json").read_text())
+    assert agg["results"]["curriculum"]["heldout"]["success_rate"]["mean"] == pytest.approx(2 / 3)
+    assert agg["training_arguments"] == ["--steps", "600", "--her-ratio", "0.5"]
+    assert tool.main(["--seeds", "0", "--out", str(out), "--seed", "3"]) == 2  # set per seed by the tool
+    with pytest.raises(SystemExit):
+        tool.main(["--seeds", "0,x"])
+
+
+def test_benchmark_seeds_end_to_end_and_rerun_does_not_retrain(tmp_path, tool_env):
+    out = tmp_path / "seeds"
+    # seed 0 trains for real; seed 1 finished in an earlier (killed) benchmark, so only its summary is read
+    os.makedirs(out / "seed_1")
+    (out / "seed_1" / "summary.json").write_text(json.dumps(summary(0.0, 0.5, 50.0)))
+    args = ["--seeds", "0,1", "--out", str(out), *TINY_TRAINING]
+    run_tool("benchmark_seeds", *args, cwd=tmp_path, env=tool_env)
+    table = (out / "seeds.md").read_text()
+    for label in ("curriculum", "baseline", "lookup"):
+        for kind in ("heldout", "heldout_moving", "track"):
+            assert f"| {label} | {kind} |" in table, table
+    agg = json.loads((out / "seeds.json").read_text())
+    assert agg["seeds"] == [0, 1] and agg["steps"]["curriculum"] == [300, 300]
+    assert agg["minutes"][0] > 0 and agg["minutes"][1] is None
+    assert 0.0 <= agg["results"]["baseline"]["heldout"]["success_rate"]["min"] <= 1.0
+    assert os.path.exists(out / "seed_0" / "curriculum" / "checkpoint.pkl")
+    summaries = [out / f"seed_{s}" / "summary.json" for s in (0, 1)]
+    mtimes = [os.stat(p).st_mtime_ns for p in summaries]
+    again = run_tool("benchmark_seeds", *args, cwd=tmp_path, env=tool_env)
+    assert [os.stat(p).st_mtime_ns for p in summaries] == mtimes
+    assert again.stdout.count("not re-run") == 2
+    assert (out / "seeds.md").read_text() == table
+
+
+def test_benchmark_dmc_end_to_end_on_cartpole(tmp_path, tool_env):
+    out = tmp_path / "dmc"
+    # min-replay 20 transitions = 160 control steps at action repeat 8: the agent learns before each evaluation
+    run_tool("benchmark_dmc", "--tasks", "cartpole/swingup", "--steps", "400", "--eval-at", "200,400",
+             "--min-replay", "20", "--hidden", "16,16", "--batch-size", "16", "--eval-episodes", "2",
+             "--out", str(out), "--quiet", cwd=tmp_path, env=tool_env)
+    result = json.loads((out / "dmc.json").read_text())
+    rows = result["rows"]
+    assert [(r["task"], r["seed"], r["eval_step"]) for r in rows] == [("cartpole/swingup", 0, 200),
+                                                                     ("cartpole/swingup", 0, 400)]
+    for r in rows:
+        assert math.isfinite(r["return_mean"]) and math.isfinite(r["return_std"]) and r["episodes"] == 2
+        assert r["action_repeat"] == 8 and r["env_steps"] >= r["eval_step"] and r["updates"] > 0
+    assert result["configs"]["cartpole/swingup"]["action_repeat"] == 8
+    assert "| cartpole/swingup | 0 | 400 |" in (out / "dmc.md").read_text()
+
+
+def test_benchmark_dmc_rejects_unknown_settings_in_one_line():
+    tool = load_tool("benchmark_dmc")
+    assert tool.main(["--tasks", "hopper/hop", "--steps", "100"]) == 2  # no published action repeat
+    args = tool.build_parser().parse_args(["--eval-at", "100000,200000"])
+    assert tool.task_settings(args, "cartpole/swingup") == (100_000, 8, [100_000])
+    assert tool.task_settings(args, "reacher/easy") == (200_000, 4, [100_000, 200_000])

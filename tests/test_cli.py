@@ -1,0 +1,162 @@
+"""The installed console scripts, run as a user runs them: exit status and what reaches stderr.
+
+Success: status 0, no traceback and no dumped return value on stderr.  An
+expected user error: non-zero status and one line `robostrich-X: error: ...`
+(after argparse's usage lines for a usage error), no traceback.
+"""
+import os
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from agents import checkpoint
+
+TINY_TRAIN = ["--plan", "lesson1:250", "--no-baseline", "--hidden", "16,16", "--batch-size", "16",
+              "--min-replay", "50", "--num-eval-targets", "1", "--final-eval-targets", "1", "--quiet",
+              "--no-rerun", "--no-figures"]
+
+
+def script(name: str) -> str:
+    """The console script next to this interpreter (the venv's), else on PATH."""
+    path = os.path.join(os.path.dirname(sys.executable), name)
+    path = path if os.path.exists(path) else shutil.which(name)
+    if path is None:
+        pytest.skip(f"{name} is not installed (pip install -e .)")
+    return path
+
+
+ENVIRONMENT = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+
+
+@pytest.fixture(scope="module", autouse=True)
+def shared_jax_cache(tmp_path_factory):
+    """One persistent XLA cache for this module's processes: evaluate reuses train's compilations (~6 s)."""
+    ENVIRONMENT.update(JAX_COMPILATION_CACHE_DIR=str(tmp_path_factory.mktemp("jax_cache")),
+                       JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS="0", JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES="0")
+
+
+def start(name, *args, cwd=None):
+    return subprocess.Popen([script(name), *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=ENVIRONMENT, cwd=cwd)
+
+
+def finish(process, timeout=300):
+    stdout, stderr = process.communicate(timeout=timeout)
+    return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
+
+
+def call(name, *args, cwd=None):
+    return finish(start(name, *args, cwd=cwd))
+
+
+def assert_succeeded(result):
+    name = os.path.basename(result.args[0])
+    assert result.returncode == 0, f"{name} exited {result.returncode}; stderr:\n{result.stderr[-3000:]}"
+    assert "Traceback" not in result.stderr, result.stderr[-3000:]
+    assert not result.stderr.lstrip().startswith(("{", "[", "(")), f"{name} dumped its result: {result.stderr[:300]}"
+    assert len(result.stderr) < 2000, f"{name} wrote {len(result.stderr)} characters to stderr"
+
+
+def assert_user_error(result, *fragments):
+    """Non-zero status; the last stderr line is the one-line error (argparse puts its usage above)."""
+    name = os.path.basename(result.args[0])
+    assert result.returncode not in (0, None), f"{name} succeeded; stdout:\n{result.stdout[-2000:]}"
+    assert "Traceback" not in result.stderr, result.stderr[-3000:]
+    lines = result.stderr.strip().splitlines()
+    assert lines and lines[-1].startswith(f"{name}: error: "), result.stderr[-3000:]
+    if not lines[0].startswith("usage:"):  # not an argparse usage error: the error line is all there is
+        assert len(lines) == 1, result.stderr
+    for fragment in fragments:
+        assert fragment in lines[-1], (fragment, lines[-1])
+    return lines[-1]
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory):
+    """One tiny `robostrich-train` run: (its result, its run directory)."""
+    out = tmp_path_factory.mktemp("cli") / "run"
+    return call("robostrich-train", *TINY_TRAIN, "--out", out), out
+
+
+def test_train_exits_zero_and_writes_its_run(trained):
+    result, out = trained
+    assert_succeeded(result)
+    for name in ("config.json", "summary.json", "curriculum/checkpoint.pkl", "evaluation/curriculum_heldout.json"):
+        assert (out / name).stat().st_size > 0, name
+    assert '"curriculum"' in result.stdout  # the summary goes to stdout, not a dump to stderr
+
+
+def test_evaluate_exits_zero_on_a_checkpoint(trained, tmp_path):
+    _, out = trained
+    result = call("robostrich-evaluate", out / "curriculum" / "checkpoint.pkl", "--out", tmp_path / "ev",
+                  "--num-targets", "1", "--no-rerun", "--no-figures")
+    assert_succeeded(result)
+    assert (tmp_path / "ev" / "summary.json").stat().st_size > 0
+
+
+def test_the_other_scripts_exit_zero(tmp_path):
+    runs = {  # cheap real invocations, run side by side
+        "robostrich-export-xml": ["--out", tmp_path / "xml"],
+        "robostrich-walk": ["--seconds", "0.2", "--no-rrd", "--out", tmp_path / "walk" / "walk"],
+        "robostrich-movement": ["--out", tmp_path / "movement", "--patterns", "lever", "--no-match-travel",
+                                "--ramp-time", "0.05", "--no-recording", "--no-progress"],
+        "robostrich-workspace": ["--out", tmp_path / "workspace", "--samples", "200", "--edge-samples", "200",
+                                 "--actuated-samples", "0", "--no-progress"],
+    }
+    processes = {name: start(name, *args) for name, args in runs.items()}
+    for name, process in processes.items():
+        assert_succeeded(finish(process))
+    assert (tmp_path / "movement" / "lever.png").exists() and (tmp_path / "workspace" / "workspace.png").exists()
+
+
+def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
+    empty = tmp_path / "empty_run"
+    empty.mkdir()
+    checkpoint.save(str(tmp_path / "whole.pkl"), {"weights": list(range(2000))}, {"seed": 0})
+    data = (tmp_path / "whole.pkl").read_bytes()
+    (tmp_path / "truncated.pkl").write_bytes(data[:len(data) // 2])
+    (tmp_path / "empty.pkl").write_bytes(b"")
+    cases = {  # side by side: each only parses, imports and checks
+        "resume_empty": start("robostrich-train", "--resume", "--quiet", "--out", empty),
+        "checkpoint_every_0": start("robostrich-train", "--checkpoint-every", "0", "--out", tmp_path / "ck0"),
+        "truncated": start("robostrich-evaluate", tmp_path / "truncated.pkl", "--num-targets", "1", "--no-rerun",
+                           "--no-figures"),
+        "empty": start("robostrich-evaluate", tmp_path / "empty.pkl", "--num-targets", "1"),
+    }
+    results = {case: finish(p) for case, p in cases.items()}
+    assert_user_error(results["resume_empty"], "--resume", "no checkpoint", str(empty))
+    assert os.listdir(empty) == []  # nothing started
+    assert_user_error(results["checkpoint_every_0"], "--checkpoint-every")
+    assert results["checkpoint_every_0"].returncode == 2 and not (tmp_path / "ck0").exists()
+    assert_user_error(results["truncated"], "truncated.pkl", "damaged")
+    assert_user_error(results["empty"], "empty.pkl", "not a robostrich SAC checkpoint")
+    for case in ("resume_empty", "truncated", "empty"):
+        assert results[case].returncode == 2, (case, results[case].stderr)
+
+
+def test_read_fingerprint_checks_the_file(tmp_path):
+    path = tmp_path / "c.pkl"
+    checkpoint.save(str(path), {"x": 1}, {"seed": 3})
+    assert checkpoint.read_fingerprint(str(path)) == {"seed": 3}
+    data = path.read_bytes()
+    for damaged in (b"", data[:20], data[:-1], data[:-1] + bytes([data[-1] ^ 1])):
+        path.write_bytes(damaged)
+        with pytest.raises(checkpoint.CheckpointError, match="c.pkl"):
+            checkpoint.read_fingerprint(str(path))
+
+
+def test_rejected_resume_leaves_the_run_unchanged(trained, tmp_path):
+    _, out = trained
+    run = tmp_path / "run"
+    shutil.copytree(out, run)
+    before = {p: p.read_bytes() for p in run.rglob("*") if p.is_file()}
+    other = [a if a != "16,16" else "32,32" for a in TINY_TRAIN]  # another network: another configuration
+    result = call("robostrich-train", *other, "--out", run, "--resume")
+    assert_user_error(result, "different configuration", "hidden_sizes")
+    assert result.returncode == 2
+    after = {p: p.read_bytes() for p in run.rglob("*") if p.is_file()}
+    assert after.keys() == before.keys()
+    assert after[run / "config.json"] == before[run / "config.json"]
+    assert after == before

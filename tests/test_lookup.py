@@ -1,0 +1,83 @@
+"""The lookup baseline on the real arm, and evaluation on a dm_control domain without a head (reacher)."""
+import collections
+import json
+import os
+
+import numpy as np
+import pytest
+from dm_env import specs
+
+from agents import evaluation
+from agents.curriculum import CurriculumRun, make_environment, parse_plan
+from agents.lookup import LookupPolicy, lookup_table
+from agents.replay import ObservationFlattener
+from agents.sac.builder import SACBuilder
+from agents.sac.config import SACConfig
+from robostrich_suite import targets
+
+
+@pytest.fixture(scope="module")
+def flattener():
+    return ObservationFlattener(make_environment("robostrich", "lesson2", 0).observation_spec())
+
+
+def distances(a, b):
+    return np.linalg.norm(np.asarray(a)[:, None, :] - np.asarray(b)[None, :, :], axis=2)
+
+
+def test_lookup_table_holds_no_pose_at_a_heldout_target():
+    table = lookup_table()
+    poses = targets.level_head_poses()["head_position"]
+    heldout, training = targets.heldout_targets(), targets.training_targets()
+    assert distances(heldout, poses).min(axis=1).max() == 0.0  # every held-out target is a stored pose ...
+    assert distances(table["head_position"], heldout).min() >= targets.MIN_TARGET_SPACING  # ... none in the table
+    assert distances(training, table["head_position"]).min(axis=1).max() == 0.0  # every training pose is
+    assert len(table["control"]) == len(table["head_position"]) > len(training)
+
+
+def test_lookup_holds_a_stored_training_pose(flattener):
+    policy = LookupPolicy(flattener)
+    target = targets.training_targets()[0]
+    report = evaluation.evaluate_heldout(policy, flattener, "robostrich", "lesson2", targets=target[None])
+    episode = report["episodes"][0]
+    assert episode["success"], episode
+    assert episode["final_position_error"] < 0.01 and episode["final_attitude_error"] < 5.0, episode
+    np.testing.assert_array_equal(policy.control_for(target), lookup_table()["control"][
+        np.flatnonzero(np.all(lookup_table()["head_position"] == target, axis=1))[0]])
+
+
+def test_lookup_needs_a_target_position():
+    spec = collections.OrderedDict(position=specs.Array((2,), np.float64), velocity=specs.Array((2,), np.float64))
+    with pytest.raises(ValueError, match="target_position"):
+        LookupPolicy(ObservationFlattener(spec))
+
+
+def test_heldout_moving_starts_from_poses_holding_other_targets(flattener):
+    policy = LookupPolicy(flattener)
+    target = targets.heldout_targets()[:1]
+    report = evaluation.evaluate_heldout_moving(policy, flattener, "robostrich", targets=target)
+    starts, _ = evaluation.moving_starts()
+    assert report["summary"]["episodes"] == 3 and [e["start"] for e in report["episodes"]] == [0, 1, 2]
+    assert distances(starts, targets.training_targets()).min(axis=1).max() == 0.0  # starts are training targets
+    assert distances(starts, starts)[np.triu_indices(3, 1)].min() > 0.2  # well separated
+    for episode in report["episodes"]:
+        assert episode["start_position_error"] < 0.01  # the arm really held the start pose
+        assert episode["target"] == target[0].tolist()
+    # different starts give different endings: the start pose was carried into the episode
+    assert len({round(e["final_position_error"], 6) for e in report["episodes"]}) > 1
+
+
+def test_evaluation_on_reacher_reports_returns_not_nan(tmp_path):
+    config = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=200, max_replay_size=5000)
+    run = CurriculumRun(parse_plan("reacher/easy:1000"), config, seed=0, run_dir=str(tmp_path / "run"))
+    actor = SACBuilder.make_eval_actor(run.loop)  # untrained
+    reports = evaluation.evaluate_agent(actor, run.loop.flattener, str(tmp_path / "ev"), "sac", "reacher", "easy",
+                                        None, num_targets=2, record=False)
+    assert list(reports) == ["heldout"]  # no moving starts or track off the arm
+    summary = reports["heldout"]["summary"]
+    assert set(summary) == {"episodes", "return_mean", "return_std", "return_min", "return_max"}
+    assert summary["episodes"] == 2 and all(np.isfinite(v) for v in summary.values())
+    assert summary["return_min"] <= summary["return_mean"] <= summary["return_max"]
+    text = open(os.path.join(tmp_path, "ev", "sac_heldout.json")).read()
+    assert "NaN" not in text and json.loads(text)["episodes"][0]["steps"] == 1000
+    assert evaluation.evaluate_lookup(str(tmp_path / "ev"), "reacher", "easy", None) is None

@@ -1,0 +1,210 @@
+"""This SAC on standard dm_control tasks, against published state-SAC returns: is the agent itself sound?
+
+    python tools/benchmark_dmc.py [--tasks reacher/easy,cartpole/swingup] [--seeds 0] [--steps N]
+                                  [--eval-at 100000,200000] [--out runs/dmc]
+
+Benchmark settings as published for state SAC on DMC (PlaNet's action repeats: reacher 4,
+cartpole 8; budgets and evaluation points in environment (control) steps; 10 deterministic
+evaluation episodes).  Default budgets: reacher/easy 200k, cartpole/swingup 100k.  Results go
+to OUT/dmc.json (after every evaluation, so a killed run keeps what it measured) and OUT/dmc.md.
+"""
+import argparse
+import json
+import os
+import sys
+import time
+from collections import deque
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+# PlaNet's action repeats, used by the state-SAC baselines of CURL/DrQ; budgets are this tool's defaults.
+ACTION_REPEAT = {"reacher/easy": 4, "cartpole/swingup": 8, "cheetah/run": 4, "finger/spin": 2,
+                 "walker/walk": 2, "ball_in_cup/catch": 4}
+DEFAULT_STEPS = {"reacher/easy": 200_000, "cartpole/swingup": 100_000}
+# Published state-SAC evaluation returns (approximate; the "State SAC" column of CURL, Srinivas et al. 2020).
+REFERENCE = {"reacher/easy": {100_000: 750, 500_000: 920}, "cartpole/swingup": {100_000: 835}}
+REFERENCE_SOURCE = "published state SAC (CURL, Srinivas et al. 2020, Table 1), approximate"
+
+
+def _ints(text: str, what: str):
+    try:
+        values = [int(float(s)) for s in text.split(",") if s.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{what} wants comma-separated integers, got {text!r}") from None
+    if not values:
+        raise argparse.ArgumentTypeError(f"{what} is empty")
+    return values
+
+
+def build_parser():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
+    p.add_argument("--tasks", default="reacher/easy,cartpole/swingup", help="comma-separated domain/task")
+    p.add_argument("--seeds", type=lambda s: _ints(s, "--seeds"), default=[0], help="comma-separated (default 0)")
+    p.add_argument("--steps", type=int, default=None,
+                   help="environment steps per task (default: reacher/easy 200000, cartpole/swingup 100000)")
+    p.add_argument("--eval-at", type=lambda s: _ints(s, "--eval-at"), default=[100_000, 200_000],
+                   help="evaluation points (environment steps); those beyond a task's budget are dropped")
+    p.add_argument("--eval-episodes", type=int, default=10, help="deterministic episodes per evaluation")
+    p.add_argument("--action-repeat", type=int, default=None, help="override the published action repeat")
+    p.add_argument("--out", default="runs/dmc", help="writes dmc.json, dmc.md and one directory per run")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    g = p.add_argument_group("SAC")
+    g.add_argument("--hidden", default="256,256")
+    g.add_argument("--batch-size", type=int, default=256)
+    g.add_argument("--learning-rate", type=float, default=3e-4)
+    g.add_argument("--critic-layer-norm", action=argparse.BooleanOptionalAction, default=False)
+    g.add_argument("--updates-per-call", type=int, default=8)
+    g.add_argument("--env-steps-per-call", type=int, default=8, help="agent steps (transitions) between learner calls")
+    g.add_argument("--min-replay", type=int, default=5000, help="transitions (agent steps) of uniform actions first")
+    return p
+
+
+def task_settings(args, task: str):
+    """(budget, action repeat, evaluation points) of one task; ValueError names what is missing."""
+    from dm_control import suite
+    if tuple(task.split("/")) not in suite.ALL_TASKS:
+        raise ValueError(f"{task!r} is not a dm_control suite domain/task (e.g. cartpole/swingup)")
+    steps = args.steps if args.steps is not None else DEFAULT_STEPS.get(task)
+    if steps is None:
+        raise ValueError(f"no default budget for {task}; pass --steps")
+    repeat = args.action_repeat or ACTION_REPEAT.get(task)
+    if repeat is None:
+        raise ValueError(f"no published action repeat for {task}; pass --action-repeat")
+    eval_at = sorted({s for s in args.eval_at if 0 < s <= steps}) or [steps]
+    return steps, repeat, eval_at
+
+
+def reference_at(task: str, step: int):
+    return REFERENCE.get(task, {}).get(step)
+
+
+class Progress:
+    """tqdm over all environment steps of all runs, with the run and its recent training return."""
+
+    def __init__(self, total: int, enabled: bool):
+        from tqdm import tqdm
+        self.bar = tqdm(total=total, unit="step", dynamic_ncols=True, smoothing=0.05, disable=not enabled)
+        self.returns = deque(maxlen=10)
+        self.label = ""
+
+    def on_episode(self, record):
+        self.returns.append(record["return"])
+
+    def update(self, n, run):
+        self.bar.update(n)
+        ret = sum(self.returns) / len(self.returns) if self.returns else float("nan")
+        self.bar.set_postfix(run=self.label, ret=f"{ret:.0f}", refresh=False)
+
+    def start(self, label):
+        self.label = label
+        self.returns.clear()
+
+
+def format_table(rows) -> str:
+    """Markdown: deterministic evaluation return per task, seed and step, beside the published one."""
+    lines = ["| task | seed | env steps | return (mean ± std) | episodes | published state SAC |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        ref = "-" if r["reference"] is None else f"~{r['reference']}"
+        lines.append(f"| {r['task']} | {r['seed']} | {r['eval_step']} | "
+                     f"{r['return_mean']:.1f} ± {r['return_std']:.1f} | {r['episodes']} | {ref} |")
+    seeds = sorted({r["seed"] for r in rows})
+    if len(seeds) > 1:
+        lines += ["", "| task | env steps | mean over seeds [min, max] | seeds |", "|---|---|---|---|"]
+        for key in sorted({(r["task"], r["eval_step"]) for r in rows}):
+            means = [r["return_mean"] for r in rows if (r["task"], r["eval_step"]) == key]
+            lines.append(f"| {key[0]} | {key[1]} | {sum(means) / len(means):.1f} [{min(means):.1f}, {max(means):.1f}] "
+                         f"| {len(means)} |")
+    refs = "; ".join(f"{t}: " + ", ".join(f"~{v} at {s // 1000}k" for s, v in sorted(r.items()))
+                     for t, r in REFERENCE.items())
+    return "\n".join(lines + ["", f"Reference ({REFERENCE_SOURCE}): {refs}."]) + "\n"
+
+
+def write_atomic(path: str, text: str) -> None:
+    """Readers never see a half-written file: write beside it, then rename."""
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def train_and_evaluate(task, seed, steps, eval_at, config, args, progress, on_row):
+    """One SAC run on `task`; `on_row(row)` after each deterministic evaluation."""
+    from agents import evaluation
+    from agents.curriculum import CurriculumRun, parse_plan
+    from agents.sac.builder import SACBuilder
+    domain, task_name = task.split("/")
+    run_dir = os.path.join(args.out, task.replace("/", "_"), f"seed_{seed}")
+    run = CurriculumRun(parse_plan(f"{task}:{steps}"), config, seed, run_dir, checkpoint_every=steps, name=task)
+    for path in (run.metrics_path, run.evals_path):  # a fresh run: no records of an earlier one
+        if os.path.exists(path):
+            os.unlink(path)
+    pending = list(eval_at)
+    start = time.time()
+
+    def on_eval(r):
+        while pending and pending[0] <= r.loop.env_steps:
+            step = pending.pop(0)
+            actor = SACBuilder.make_eval_actor(r.loop)
+            report = evaluation.evaluate_heldout(actor, r.loop.flattener, domain, task_name,
+                                                 num_targets=args.eval_episodes, action_repeat=config.action_repeat)
+            s = report["summary"]
+            on_row({"task": task, "seed": seed, "eval_step": step, "env_steps": r.loop.env_steps,
+                    "return_mean": s["return_mean"], "return_std": s["return_std"],
+                    "return_min": s["return_min"], "return_max": s["return_max"], "episodes": s["episodes"],
+                    "reference": reference_at(task, step), "action_repeat": config.action_repeat,
+                    "updates": r.loop.learner.num_updates, "minutes": (time.time() - start) / 60.0})
+
+    progress.start(f"{task} seed {seed}")
+    run.run(progress=progress, on_eval=on_eval, eval_at=eval_at)
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
+    try:
+        if not tasks:
+            raise ValueError("--tasks is empty")
+        if args.eval_episodes <= 0:
+            raise ValueError("--eval-episodes must be positive")
+        settings = {t: task_settings(args, t) for t in tasks}
+        from agents.sac.config import SACConfig
+        configs = {t: SACConfig(batch_size=args.batch_size, learning_rate=args.learning_rate,
+                                hidden_sizes=tuple(int(h) for h in args.hidden.split(",") if h),
+                                min_replay_size=args.min_replay, updates_per_call=args.updates_per_call,
+                                env_steps_per_call=args.env_steps_per_call, action_repeat=settings[t][1],
+                                critic_layer_norm=args.critic_layer_norm) for t in tasks}
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    os.makedirs(args.out, exist_ok=True)
+    rows = []
+    result = {"arguments": vars(args), "configs": {t: c.to_dict() for t, c in configs.items()},
+              "reference": {t: {str(s): v for s, v in r.items()} for t, r in REFERENCE.items()},
+              "reference_source": REFERENCE_SOURCE, "rows": rows}
+
+    def on_row(row):
+        rows.append(row)
+        progress.bar.write(f"{row['task']} seed {row['seed']} at {row['eval_step']} steps: return "
+                           f"{row['return_mean']:.1f} ± {row['return_std']:.1f} (reference "
+                           f"{'-' if row['reference'] is None else '~%d' % row['reference']})")
+        write_atomic(os.path.join(args.out, "dmc.json"), json.dumps(result, indent=1))
+
+    progress = Progress(sum(settings[t][0] for t in tasks) * len(args.seeds), enabled=not args.quiet)
+    try:
+        for task in tasks:
+            steps, _, eval_at = settings[task]
+            for seed in args.seeds:
+                train_and_evaluate(task, seed, steps, eval_at, configs[task], args, progress, on_row)
+    finally:
+        progress.bar.close()
+    table = format_table(rows)
+    write_atomic(os.path.join(args.out, "dmc.json"), json.dumps(result, indent=1))
+    write_atomic(os.path.join(args.out, "dmc.md"), table)
+    print(table)
+    print(f"wrote {os.path.join(args.out, 'dmc.md')} and dmc.json")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
