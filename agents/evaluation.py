@@ -212,6 +212,17 @@ def evaluate_agent(actor, flattener, out_dir: str, label: str, domain: str, held
     return reports
 
 
+def read_reports(out_dir: str, label: str) -> dict:
+    """The reports `evaluate_agent` wrote for `label` (kind -> report), e.g. by a worker process."""
+    reports = {}
+    for kind in ("heldout", "heldout_moving", "track"):
+        path = os.path.join(out_dir, f"{label}_{kind}.json")
+        if os.path.exists(path):
+            with open(path) as f:
+                reports[kind] = json.load(f)
+    return reports
+
+
 def evaluate_lookup(out_dir: str, domain: str, heldout_task: str, track_task: Optional[str],
                     num_targets: Optional[int] = None, record: bool = True) -> Optional[dict]:
     """`evaluate_agent` for the lookup baseline (label `lookup`) on the arm; None on other domains.

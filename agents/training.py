@@ -13,11 +13,13 @@ Run directory:
     summary.json
 """
 import argparse
+import dataclasses
 import json
 import os
 import sys
 import time
 from collections import deque
+from typing import Optional
 
 import numpy as np
 
@@ -101,41 +103,62 @@ def build_parser():
     p.add_argument("--no-rerun", action="store_true")
     p.add_argument("--no-figures", action="store_true")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--workers", type=positive_int, default=min(2, os.cpu_count() or 1),
+                   help="runs trained at once, one process each (default: %(default)s; the curriculum and "
+                        "the plain-SAC baseline are independent)")
     p.add_argument("--stop-at-step", type=int, default=None, help=argparse.SUPPRESS)  # imitates a kill (tests)
-    g = p.add_argument_group("SAC")
-    g.add_argument("--batch-size", type=int, default=256)
-    g.add_argument("--hidden", type=str, default="256,256")
-    g.add_argument("--learning-rate", type=float, default=3e-4)
-    g.add_argument("--discount", type=float, default=0.99)
-    g.add_argument("--tau", type=float, default=0.005)
-    g.add_argument("--init-temperature", type=float, default=1.0)
-    g.add_argument("--min-replay", type=int, default=2_000, help="transitions before learning starts")
-    g.add_argument("--replay-size", type=int, default=1_000_000)
-    g.add_argument("--updates-per-call", type=int, default=8)
-    g.add_argument("--env-steps-per-call", type=int, default=8,
-                   help="agent steps between learner calls; update-to-data ratio = updates-per-call / this")
-    g.add_argument("--action-repeat", type=int, default=5, help="control steps per agent decision")
-    g.add_argument("--reward-scale", type=float, default=1.0, help="multiplies rewards in the critic's target")
-    g.add_argument("--target-entropy", type=float, default=None, help="temperature target (default: -|A|)")
-    g.add_argument("--critic-layer-norm", action=argparse.BooleanOptionalAction, default=False,
-                   help="LayerNorm in the critics' hidden layers")
-    g.add_argument("--her-ratio", type=float, default=0.0,
-                   help="share of each batch relabelled with a goal reached later in the episode (HER)")
-    g.add_argument("--relabel-rewards", action=argparse.BooleanOptionalAction, default=False,
-                   help="recompute sampled rewards with the current lesson's reward function")
+    add_config_arguments(p.add_argument_group("SAC (defaults: agents/sac/config.py)"))
     return p
 
 
-def config_from_args(args) -> SACConfig:
-    return SACConfig(batch_size=args.batch_size, learning_rate=args.learning_rate, discount=args.discount,
-                     tau=args.tau, init_temperature=args.init_temperature,
-                     hidden_sizes=tuple(int(h) for h in args.hidden.split(",") if h),
-                     min_replay_size=args.min_replay, max_replay_size=args.replay_size,
-                     updates_per_call=args.updates_per_call, env_steps_per_call=args.env_steps_per_call,
-                     action_repeat=args.action_repeat, reward_scale=args.reward_scale,
-                     target_entropy=args.target_entropy,
-                     critic_layer_norm=args.critic_layer_norm, her_ratio=args.her_ratio,
-                     relabel_rewards=args.relabel_rewards)
+# Older spellings kept for the fields whose flag was named before the CLI was generated.
+_FLAG_ALIASES = {"hidden_sizes": ("--hidden",), "min_replay_size": ("--min-replay",),
+                 "max_replay_size": ("--replay-size",)}
+
+
+def add_config_arguments(group, defaults: SACConfig = SACConfig()):
+    """One flag per SACConfig field (``--field-name``), its default read from the dataclass: the
+    dataclass is the one home of the training defaults, the CLI only exposes them."""
+    for field in dataclasses.fields(SACConfig):
+        default = getattr(defaults, field.name)
+        flags = ("--" + field.name.replace("_", "-"),) + _FLAG_ALIASES.get(field.name, ())
+        help_text = f"(default: {default if not isinstance(default, tuple) else ','.join(map(str, default))})"
+        if isinstance(default, bool):
+            group.add_argument(*flags, dest=field.name, action=argparse.BooleanOptionalAction,
+                               default=default, help=help_text)
+        elif isinstance(default, tuple):
+            group.add_argument(*flags, dest=field.name, default=",".join(map(str, default)), help=help_text)
+        elif default is None:
+            group.add_argument(*flags, dest=field.name, type=float, default=None, help=help_text)
+        else:
+            group.add_argument(*flags, dest=field.name, type=type(default), default=default, help=help_text)
+    group.add_argument("--paper-sac", action="store_true",
+                       help="the paper's plain SAC (Acme defaults, no agent improvements); "
+                            "flags given explicitly still apply on top")
+
+
+def config_from_args(args, argv=None) -> SACConfig:
+    values = {f.name: getattr(args, f.name) for f in dataclasses.fields(SACConfig)}
+    values["hidden_sizes"] = tuple(int(h) for h in str(values["hidden_sizes"]).split(",") if h)
+    if getattr(args, "paper_sac", False):
+        explicit = _explicit_fields(argv)
+        paper = SACConfig.paper_sac().to_dict()
+        values = {k: (v if k in explicit else paper[k]) for k, v in values.items()}
+        values["hidden_sizes"] = tuple(values["hidden_sizes"])
+    return SACConfig(**values)
+
+
+def _explicit_fields(argv) -> set:
+    """Config fields named on the command line (so --paper-sac does not override them)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    named = set()
+    for field in dataclasses.fields(SACConfig):
+        flags = ("--" + field.name.replace("_", "-"),) + _FLAG_ALIASES.get(field.name, ())
+        for token in argv:
+            option = token.split("=", 1)[0]
+            if option in flags or option == "--no-" + field.name.replace("_", "-"):
+                named.add(field.name)
+    return named
 
 
 def plan_from_args(args):
@@ -154,9 +177,142 @@ def read_jsonl(path):
         return [json.loads(l) for l in f if l.strip()]
 
 
+@dataclasses.dataclass(frozen=True)
+class RunJob:
+    """What a run does besides training: periodic and final evaluation (picklable, for a worker)."""
+
+    domain: str
+    heldout_task: str
+    track_task: Optional[str]
+    eval_at: tuple
+    num_eval_targets: int
+    final_eval_targets: Optional[int]
+    out_eval: str
+    record: bool
+    stop_at_step: Optional[int] = None
+
+
+def train_and_evaluate(run: CurriculumRun, job: RunJob, progress=None) -> dict:
+    """Finish `run`'s plan (periodic held-out evaluations in its evals.jsonl), then its final
+    evaluation (JSON reports in job.out_eval). Returns the reports and the run's counters."""
+    config = run.config
+    timing = None
+    if not run.done:
+        if progress is not None:
+            progress.reset_window()
+
+        def on_eval(r):
+            actor = SACBuilder.make_eval_actor(r.loop)
+            report = evaluation.evaluate_heldout(actor, r.loop.flattener, job.domain, job.heldout_task,
+                                                 job.num_eval_targets, action_repeat=config.action_repeat)
+            record = {"env_steps": r.loop.env_steps, "lessons_completed": r.lesson_index, "summary": report["summary"]}
+            with open(r.evals_path, "a") as f:
+                f.write(json.dumps(record) + "\n")
+
+        start, start_steps = time.time(), run.loop.env_steps
+        run.run(progress=progress, on_eval=on_eval, eval_at=job.eval_at, stop_at_step=job.stop_at_step)
+        timing = {"seconds": time.time() - start, "env_steps": run.loop.env_steps - start_steps,
+                  "updates": run.loop.learner.num_updates}
+    num_targets = job.final_eval_targets or (None if job.domain in ROBOSTRICH_DOMAINS else job.num_eval_targets)
+    reports = evaluation.evaluate_agent(SACBuilder.make_eval_actor(run.loop), run.loop.flattener, job.out_eval,
+                                        run.name, job.domain, job.heldout_task, job.track_task, num_targets,
+                                        env_steps=run.loop.env_steps, record=job.record,
+                                        action_repeat=config.action_repeat)
+    return {"reports": reports, "env_steps": run.loop.env_steps, "updates": run.loop.learner.num_updates,
+            "timing": timing}
+
+
+class _QueueProgress:
+    """Stands in for `Progress` inside a worker: forwards steps and episodes to the parent's bar."""
+
+    def __init__(self, queue, label):
+        self.queue, self.label = queue, label
+
+    def on_episode(self, record):
+        self.queue.put(("episode", self.label, {"return": record["return"], "success": record["success"]}))
+
+    def update(self, n, run):
+        lesson = f"{run.lesson_index + 1 if not run.done else len(run.plan)}/{len(run.plan)}"
+        self.queue.put(("steps", self.label, (n, lesson)))
+
+    def reset_window(self):
+        pass
+
+
+def _worker(label, plan, config_dict, seed, run_dir, checkpoint_every, job, queue):
+    """One run in its own process: restore its latest checkpoint (if any), train, evaluate."""
+    run = CurriculumRun(plan, SACConfig.from_dict(config_dict), seed, run_dir,
+                        checkpoint_every=checkpoint_every, name=label)
+    if os.path.exists(run.checkpoint_path):
+        run.restore()
+    try:
+        outcome = train_and_evaluate(run, job, _QueueProgress(queue, label))
+        queue.put(("done", label, {k: v for k, v in outcome.items() if k != "reports"}))
+    except BaseException as error:  # the parent reports it; a traceback here would interleave the bar
+        queue.put(("error", label, f"{type(error).__name__}: {error}"))
+        raise
+
+
+def _train_in_parallel(runs: dict, job: RunJob, progress, workers: int) -> dict:
+    """Each run in its own process (one core each): the curriculum and the plain-SAC baseline are
+    independent, so on two cores the main job takes the time of one run. Workers restore from and
+    write the same checkpoints as a sequential run, so results are identical and resumable."""
+    import multiprocessing
+    context = multiprocessing.get_context("spawn")
+    queue = context.Queue()
+    # One intra-op thread per worker; set before the spawned interpreters import JAX.
+    saved = os.environ.get("XLA_FLAGS")
+    os.environ["XLA_FLAGS"] = ((saved or "") + " --xla_cpu_multi_thread_eigen=false"
+                               " intra_op_parallelism_threads=1").strip()
+    pending = [label for label in runs]
+    active, outcomes, errors = {}, {}, {}
+    try:
+        while pending or active:
+            while pending and len(active) < workers:
+                label = pending.pop(0)
+                run = runs[label]  # a fresh worker builds the same run from the same seed, or restores it
+                process = context.Process(target=_worker, args=(
+                    label, run.plan, run.config.to_dict(), run.seed, run.run_dir, run.checkpoint_every, job, queue))
+                process.start()
+                active[label] = process
+            try:
+                kind, label, payload = queue.get(timeout=1.0)
+            except Exception:  # queue.Empty: check for workers that died without a word
+                for label, process in list(active.items()):
+                    if not process.is_alive() and label not in outcomes:
+                        errors.setdefault(label, f"worker exited with status {process.exitcode}")
+                        del active[label]
+                continue
+            if kind == "steps":
+                n, lesson = payload
+                if progress.bar is not None:
+                    progress.bar.update(n)
+                    progress.bar.set_postfix(run=label, lesson=lesson, refresh=False)
+            elif kind == "episode":
+                progress.on_episode(payload)
+            elif kind == "done":
+                outcomes[label] = payload
+                active.pop(label).join()
+            elif kind == "error":
+                errors[label] = payload
+                active.pop(label).join()
+    finally:
+        for process in active.values():
+            process.terminate()
+        if saved is None:
+            os.environ.pop("XLA_FLAGS", None)
+        else:
+            os.environ["XLA_FLAGS"] = saved
+    if errors:
+        raise RuntimeError("; ".join(f"{label}: {message}" for label, message in errors.items()))
+    for label, outcome in outcomes.items():
+        outcome["reports"] = evaluation.read_reports(job.out_eval, label)
+    return outcomes
+
+
 def main(argv=None):
     args = build_parser().parse_args(argv)
-    config = config_from_args(args)
+    config = config_from_args(args, argv)
     plan = plan_from_args(args)
     total = sum(l.steps for l in plan)
     final = plan[-1]
@@ -206,45 +362,27 @@ def main(argv=None):
         "argv": sys.argv if argv is None else list(argv), "config": config.to_dict(),
         "plans": {k: format_plan(v) for k, v in run_plans.items()}, "seed": args.seed})
 
+    out_eval = os.path.join(args.out, "evaluation")
+    job = RunJob(domain=domain, heldout_task=heldout_task, track_task=track_task, eval_at=tuple(eval_at),
+                 num_eval_targets=args.num_eval_targets, final_eval_targets=args.final_eval_targets,
+                 out_eval=out_eval, record=not args.no_rerun, stop_at_step=args.stop_at_step)
     progress = Progress(sum(r.total_steps for r in runs.values()), enabled=not args.quiet)
     progress.bar and progress.bar.update(sum(r.loop.env_steps for r in runs.values()))
-    timings = {}
+    workers = args.workers if args.stop_at_step is None else 1  # the kill hook raises in this process
     try:
-        for label, run in runs.items():
-            if run.done:
-                continue
-            progress.reset_window()
-
-            def on_eval(r):
-                actor = SACBuilder.make_eval_actor(r.loop)
-                report = evaluation.evaluate_heldout(actor, r.loop.flattener, domain, heldout_task,
-                                                     args.num_eval_targets, action_repeat=config.action_repeat)
-                record = {"env_steps": r.loop.env_steps, "lessons_completed": r.lesson_index, "summary": report["summary"]}
-                with open(r.evals_path, "a") as f:
-                    f.write(json.dumps(record) + "\n")
-
-            start, start_steps = time.time(), run.loop.env_steps
-            run.run(progress=progress, on_eval=on_eval, eval_at=eval_at, stop_at_step=args.stop_at_step)
-            timings[label] = {"seconds": time.time() - start, "env_steps": run.loop.env_steps - start_steps,
-                              "updates": run.loop.learner.num_updates}
+        if workers > 1 and len(runs) > 1:
+            outcomes = _train_in_parallel(runs, job, progress, workers)
+        else:
+            outcomes = {label: train_and_evaluate(run, job, progress) for label, run in runs.items()}
     finally:
         progress.close()
-
-    out_eval = os.path.join(args.out, "evaluation")
-    finals = {}
-    for label, run in runs.items():
-        actor = SACBuilder.make_eval_actor(run.loop)
-        finals[label] = evaluation.evaluate_agent(actor, run.loop.flattener, out_eval, label, domain, heldout_task,
-                                                  track_task, args.final_eval_targets or
-                                                  (None if domain in ROBOSTRICH_DOMAINS else args.num_eval_targets),
-                                                  env_steps=run.loop.env_steps, record=not args.no_rerun,
-                                                  action_repeat=config.action_repeat)
+    finals = {label: o["reports"] for label, o in outcomes.items()}
     lookup = evaluation.evaluate_lookup(out_eval, domain, heldout_task, track_task, args.final_eval_targets,
                                         record=not args.no_rerun)
     if lookup is not None:  # the no-learning bar, beside the agents
         finals["lookup"] = lookup
     metrics = {label: read_jsonl(run.metrics_path) for label, run in runs.items()}
-    evals = {label: read_jsonl(run.evals_path) for label, run in runs.items()}
+    evals = {label: read_jsonl(run.evals_path) for label, run in runs.items()}  # written by whoever trained
     if not args.no_figures:
         from agents import figures
         os.makedirs(os.path.join(args.out, "figures"), exist_ok=True)
@@ -258,9 +396,9 @@ def main(argv=None):
         from agents import recording
         recording.log_training_curves(os.path.join(args.out, "training.rrd"), metrics, evals)
     summary = {"runs": {label: {k: f[k]["summary"] for k in f} for label, f in finals.items()},
-               "env_steps": {label: run.loop.env_steps for label, run in runs.items()},
-               "updates": {label: run.loop.learner.num_updates for label, run in runs.items()},
-               "timings_this_session": timings}
+               "env_steps": {label: o["env_steps"] for label, o in outcomes.items()},
+               "updates": {label: o["updates"] for label, o in outcomes.items()},
+               "timings_this_session": {label: o["timing"] for label, o in outcomes.items() if o["timing"]}}
     evaluation.write_json(os.path.join(args.out, "summary.json"), summary)
     print(json.dumps(summary["runs"], indent=1))
     return summary

@@ -131,3 +131,29 @@ def test_action_repeat_holds_actions_and_sums_rewards(tmp_path):
     assert episodes[0]["length"] == 1000
     np.testing.assert_allclose(run.loop.replay.reward[:334].astype(np.float64).sum(), episodes[0]["return"],
                                rtol=1e-5, atol=1e-4)
+
+
+def test_runs_trained_in_worker_processes_equal_runs_trained_in_turn(tmp_path):
+    """--workers 2 trains the curriculum and the baseline at once, one process each: same
+    checkpoints and reports as training them one after the other."""
+    args = TINY_ARGS[:-1] + ["--plan", "point_mass/easy:500,point_mass/hard:500", "--checkpoint-every", "400"]
+    summaries = {}
+    for workers in ("1", "2"):
+        out = str(tmp_path / workers)
+        summaries[workers] = training.main(args + ["--out", out, "--workers", workers])
+    assert summaries["1"]["runs"] == summaries["2"]["runs"]
+    assert summaries["1"]["updates"] == summaries["2"]["updates"] and summaries["2"]["updates"]["baseline"] > 0
+    for label in ("curriculum", "baseline"):
+        a = checkpoint.load(str(tmp_path / "1" / label / "checkpoint.pkl"), None)
+        b = checkpoint.load(str(tmp_path / "2" / label / "checkpoint.pkl"), None)
+        for x, y in zip(leaves(a["learner"]), leaves(b["learner"])):
+            np.testing.assert_array_equal(x, y)
+
+
+def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
+    args = training.build_parser().parse_args(["--paper-sac", "--batch-size", "32"])
+    config = training.config_from_args(args, ["--paper-sac", "--batch-size", "32"])
+    assert config == SACConfig.paper_sac(batch_size=32)
+    assert not config.critic_layer_norm and config.her_ratio == 0 and config.init_temperature == 1.0
+    default = training.config_from_args(training.build_parser().parse_args([]), [])
+    assert default == SACConfig()  # the CLI's defaults are the dataclass's

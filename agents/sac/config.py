@@ -1,4 +1,4 @@
-"""Hyperparameters of the SAC agent (Acme's defaults unless noted)."""
+"""Hyperparameters of the SAC agent: the main job's defaults; `SACConfig.paper_sac()` gives Acme's plain SAC."""
 import dataclasses
 from typing import Optional, Tuple
 
@@ -11,35 +11,39 @@ class SACConfig:
     fingerprint, so a checkpoint is never resumed under different settings.
     """
 
-    batch_size: int = 256
-    learning_rate: float = 3e-4  # critics, actor and temperature alike
+    # The main job's defaults (robostrich-train generates its flags from these fields); the
+    # measurements behind each choice are in docs/learning.md. SACConfig.paper_sac() gives
+    # the paper's / Acme's plain SAC.
+    batch_size: int = 64
+    learning_rate: float = 1e-3  # critics, actor and temperature alike
     discount: float = 0.99
     tau: float = 0.005  # Polyak rate of the target critics
     target_entropy: Optional[float] = None  # None -> -|A| (Acme)
-    init_temperature: float = 1.0
-    hidden_sizes: Tuple[int, ...] = (256, 256)
-    min_replay_size: int = 10_000
+    # Acme starts at 1; on the arm's rewards (about -3 per control step) that entropy bonus
+    # outweighs the task for most of a short run, so start low and let the loss raise it.
+    init_temperature: float = 0.01
+    hidden_sizes: Tuple[int, ...] = (64, 64)
+    min_replay_size: int = 1_000
     max_replay_size: int = 1_000_000
     # The learner runs `updates_per_call` gradient steps (one lax.scan) every
     # `env_steps_per_call` agent steps (transitions): update-to-data ratio = their quotient.
-    updates_per_call: int = 8
-    env_steps_per_call: int = 8
-    # The agent acts every `action_repeat` control steps (0.008 s each); the tendon
-    # servos settle in ~1.5 s, so a decision per control step mostly adds noise.
+    updates_per_call: int = 4
+    env_steps_per_call: int = 4
+    # The agent acts every `action_repeat` control steps (0.008 s each).
     action_repeat: int = 1
     reward_scale: float = 1.0
     log_std_min: float = -5.0
     log_std_max: float = 2.0
-    # Agent improvements beyond the paper's SAC; the defaults (off) are plain SAC.
-    critic_layer_norm: bool = False  # LayerNorm in every hidden layer of both critics
+    # Agent improvements beyond the paper's SAC (paper_sac() turns them off).
+    critic_layer_norm: bool = True  # LayerNorm in every hidden layer of both critics
     # Hindsight relabelling (HER, "future" strategy) on tasks whose reward is a function of the
     # achieved head pose and the goal (robostrich's Reach): this fraction of every sampled batch
     # gets a goal the head reached later in the same episode, with the reward recomputed exactly.
-    her_ratio: float = 0.0
+    her_ratio: float = 0.5
     # Recompute every sampled transition's reward with the current lesson's reward function
     # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
     # replay then carry lesson-2 rewards instead of the ones they were collected with.
-    relabel_rewards: bool = False
+    relabel_rewards: bool = True
 
     def __post_init__(self):
         if min(self.batch_size, self.updates_per_call, self.env_steps_per_call, self.action_repeat) <= 0:
@@ -63,6 +67,18 @@ class SACConfig:
         d = dataclasses.asdict(self)
         d["hidden_sizes"] = list(self.hidden_sizes)
         return d
+
+    @classmethod
+    def paper_sac(cls, **overrides) -> "SACConfig":
+        """Plain SAC as the paper and Acme run it: batch 256, 256x256, lr 3e-4, initial
+        temperature 1, 10k random transitions first, one decision per control step, one update
+        per transition, none of this project's additions."""
+        values = dict(batch_size=256, learning_rate=3e-4, discount=0.99, tau=0.005, target_entropy=None,
+                      init_temperature=1.0, hidden_sizes=(256, 256), min_replay_size=10_000,
+                      max_replay_size=1_000_000, updates_per_call=8, env_steps_per_call=8, action_repeat=1,
+                      reward_scale=1.0, critic_layer_norm=False, her_ratio=0.0, relabel_rewards=False)
+        values.update(overrides)
+        return cls(**values)
 
     @property
     def uses_goals(self) -> bool:
