@@ -75,7 +75,10 @@ class CurriculumRun:
     """
 
     def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
-                 checkpoint_every: int = 10_000, env_factory: Callable = make_environment, name: str = "run"):
+                 checkpoint_every: int = 10_000, env_factory: Callable = make_environment, name: str = "run",
+                 task_kwargs: Optional[dict] = None):
+        """``task_kwargs`` go to every lesson's task (e.g. eq. 10's ``weights``)."""
+        self.task_kwargs = dict(task_kwargs or {})
         self.plan = list(plan)
         self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
         self.checkpoint_every = int(checkpoint_every)
@@ -91,7 +94,7 @@ class CurriculumRun:
     # -- lessons ---------------------------------------------------------------------------
     def _make_lesson_env(self, index):
         lesson = self.plan[index]
-        return self.env_factory(lesson.domain, lesson.task, self.seed + 1000 * (index + 1))
+        return self.env_factory(lesson.domain, lesson.task, self.seed + 1000 * (index + 1), **self.task_kwargs)
 
     @property
     def total_steps(self) -> int:
@@ -110,8 +113,12 @@ class CurriculumRun:
 
     # -- checkpoints -----------------------------------------------------------------------
     def fingerprint(self) -> dict:
-        return {"config": self.config.to_dict(), "plan": format_plan(self.plan), "seed": self.seed,
-                "observation_layout": self.loop.flattener.describe(), "action_size": self.loop.actor.adapter.size}
+        fingerprint = {"config": self.config.to_dict(), "plan": format_plan(self.plan), "seed": self.seed,
+                       "observation_layout": self.loop.flattener.describe(),
+                       "action_size": self.loop.actor.adapter.size}
+        if self.task_kwargs:
+            fingerprint["task_kwargs"] = self.task_kwargs
+        return fingerprint
 
     def state_dict(self) -> dict:
         loop = self.loop

@@ -261,7 +261,8 @@ def load_run_from_checkpoint(path: str):
     fp = checkpoint.read_fingerprint(path)
     scratch = tempfile.mkdtemp(prefix="robostrich-evaluate-")  # the run's own files are left untouched
     try:
-        run = CurriculumRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch)
+        run = CurriculumRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch,
+                            task_kwargs=fp.get("task_kwargs"))
         run.restore(path)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)

@@ -1,6 +1,6 @@
 """The main job: curriculum SAC (lessons 1->3) and a plain-SAC baseline, then evaluation, figures and recordings.
 
-    robostrich-train                               # defaults: writes runs/default, about an hour on 2 CPU cores
+    robostrich-train                               # defaults: writes runs/default, ~20 min on 2 CPU cores
     robostrich-train --out runs/default --resume   # continue a killed run from its last checkpoints
 
 Run directory:
@@ -29,7 +29,7 @@ from agents.curriculum import (ROBOSTRICH_DOMAINS, CurriculumRun, Lesson, format
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 
-DEFAULT_TOTAL_STEPS = 240_000  # per run: 80k control steps per lesson; both runs ~45 min on 2 shared cores
+DEFAULT_TOTAL_STEPS = 240_000  # per run: 80k control steps per lesson; the two runs train side by side
 DEFAULT_LESSONS = ("lesson1", "lesson2", "lesson3")
 
 
@@ -76,6 +76,16 @@ def positive_int(text: str) -> int:
     return value
 
 
+def _json_object(text: str) -> dict:
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise argparse.ArgumentTypeError(f"not JSON: {error}") from None
+    if not isinstance(value, dict):
+        raise argparse.ArgumentTypeError(f"expected a JSON object, got {type(value).__name__}")
+    return value
+
+
 def build_parser():
     p = argparse.ArgumentParser(description="Train curriculum SAC (and a plain-SAC baseline) on the Robostrich arm.")
     p.add_argument("--out", default="runs/default", help="run directory")
@@ -87,6 +97,9 @@ def build_parser():
     p.add_argument("--plan", default=None,
                    help="explicit plan '[domain/]task:steps,...' (overrides --steps/--lessons)")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--task-kwargs", type=_json_object, default={},
+                   help="JSON object passed to every training lesson's task, e.g. eq. 10's weights: "
+                        "'{\"weights\": {\"position_error\": 10}}' (evaluation keeps the task's defaults)")
     p.add_argument("--checkpoint-every", type=positive_int, default=25_000,
                    help="environment steps between checkpoints (default: %(default)s)")
     p.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
@@ -239,10 +252,10 @@ class _QueueProgress:
         pass
 
 
-def _worker(label, plan, config_dict, seed, run_dir, checkpoint_every, job, queue):
+def _worker(label, plan, config_dict, seed, run_dir, checkpoint_every, task_kwargs, job, queue):
     """One run in its own process: restore its latest checkpoint (if any), train, evaluate."""
     run = CurriculumRun(plan, SACConfig.from_dict(config_dict), seed, run_dir,
-                        checkpoint_every=checkpoint_every, name=label)
+                        checkpoint_every=checkpoint_every, name=label, task_kwargs=task_kwargs)
     if os.path.exists(run.checkpoint_path):
         run.restore()
     try:
@@ -272,7 +285,8 @@ def _train_in_parallel(runs: dict, job: RunJob, progress, workers: int) -> dict:
                 label = pending.pop(0)
                 run = runs[label]  # a fresh worker builds the same run from the same seed, or restores it
                 process = context.Process(target=_worker, args=(
-                    label, run.plan, run.config.to_dict(), run.seed, run.run_dir, run.checkpoint_every, job, queue))
+                    label, run.plan, run.config.to_dict(), run.seed, run.run_dir, run.checkpoint_every,
+                    run.task_kwargs, job, queue))
                 process.start()
                 active[label] = process
             try:
@@ -337,6 +351,8 @@ def main(argv=None):
         for label in existing:
             path = os.path.join(args.out, label, "checkpoint.pkl")
             expected = {"config": config.to_dict(), "plan": format_plan(run_plans[label]), "seed": args.seed}
+            if args.task_kwargs:
+                expected["task_kwargs"] = args.task_kwargs
             stored = checkpoint.read_fingerprint(path)
             checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
     os.makedirs(args.out, exist_ok=True)
@@ -348,7 +364,7 @@ def main(argv=None):
     runs = {}
     for label, run_plan in run_plans.items():
         run = CurriculumRun(run_plan, config, args.seed, os.path.join(args.out, label),
-                            checkpoint_every=args.checkpoint_every, name=label)
+                            checkpoint_every=args.checkpoint_every, name=label, task_kwargs=args.task_kwargs)
         if args.resume and os.path.exists(run.checkpoint_path):
             run.restore()  # raises on damaged/mismatched checkpoints, never restarts silently
         runs[label] = run
@@ -360,6 +376,7 @@ def main(argv=None):
                     os.unlink(p)
     evaluation.write_json(os.path.join(args.out, "config.json"), {
         "argv": sys.argv if argv is None else list(argv), "config": config.to_dict(),
+        "task_kwargs": args.task_kwargs,
         "plans": {k: format_plan(v) for k, v in run_plans.items()}, "seed": args.seed})
 
     out_eval = os.path.join(args.out, "evaluation")

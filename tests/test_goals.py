@@ -74,3 +74,20 @@ def test_resumed_her_run_is_bit_exact(tmp_path):
     for x, y in zip(*(np.asarray(v) for v in (a.loop.learner.get_state().q_params["q1_head"]["w"],
                                               b.loop.learner.get_state().q_params["q1_head"]["w"]))):
         np.testing.assert_array_equal(x, y)
+
+
+def test_task_kwargs_reach_every_lesson_and_the_checkpoint_fingerprint(tmp_path):
+    """--task-kwargs (eq. 10's weights here) go to each lesson's task; a checkpoint made with
+    other weights is refused on resume."""
+    plan = parse_plan("robostrich/lesson1:100,robostrich/lesson2:100")
+    weights = {"weights": {"position_error": 10.0}}
+    run = CurriculumRun(plan, HER, seed=0, run_dir=str(tmp_path / "a"), task_kwargs=weights)
+    assert run.loop.env.task.weights.position_error == 10.0
+    run.run()
+    assert run.done
+    path = str(tmp_path / "ckpt.pkl")
+    run.save_checkpoint(path)
+    plain = CurriculumRun(plan, HER, seed=0, run_dir=str(tmp_path / "b"))
+    assert plain.loop.env.task.weights.position_error == 2.0
+    with pytest.raises(ValueError, match="task_kwargs"):
+        plain.restore(path)
