@@ -10,8 +10,26 @@ from __future__ import annotations
 
 import collections
 import inspect
+import os
 
-from robostrich_suite import robostrich
+
+def _choose_headless_renderer():
+    """Without a display and without MUJOCO_GL, dm_control tries GLFW first and prints a GLFW
+    error at import. Pick a backend that can work here instead: EGL, else OSMesa, else none
+    (simulation needs no renderer). A MUJOCO_GL the user set is left alone."""
+    if os.environ.get("MUJOCO_GL") or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+        return
+    import ctypes.util
+    for backend, library in (("egl", "EGL"), ("osmesa", "OSMesa")):
+        if ctypes.util.find_library(library):
+            os.environ["MUJOCO_GL"] = backend
+            return
+    os.environ["MUJOCO_GL"] = "disable"
+
+
+_choose_headless_renderer()
+
+from robostrich_suite import robostrich  # noqa: E402  (after the renderer choice: it imports dm_control)
 
 _DOMAINS = collections.OrderedDict(
     (name, module) for name, module in [("robostrich", robostrich)])

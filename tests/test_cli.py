@@ -160,3 +160,13 @@ def test_rejected_resume_leaves_the_run_unchanged(trained, tmp_path):
     assert after.keys() == before.keys()
     assert after[run / "config.json"] == before[run / "config.json"]
     assert after == before
+
+
+def test_import_without_display_prints_no_glfw_error():
+    """No DISPLAY and no MUJOCO_GL: the package picks a headless backend itself (issue 11)."""
+    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "DISPLAY", "WAYLAND_DISPLAY")}
+    result = subprocess.run([sys.executable, "-c", "import os, robostrich_suite; print(os.environ['MUJOCO_GL'])"],
+                            env=env, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "GLFW" not in result.stderr and "DISPLAY" not in result.stderr, result.stderr
+    assert result.stdout.strip() in ("egl", "osmesa", "disable")
