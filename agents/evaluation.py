@@ -28,6 +28,7 @@ def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dic
     has_head = probes.head_xz(env) is not None
     series = {k: [] for k in ("time", "position_error", "attitude_error", "head_position", "head_attitude",
                               "target", "action", "reward")}
+    series["tolerances"] = list(probes.tolerances(env))  # the task's own, not the paper's constants
     if recorder is not None:
         recorder.log_step(env, None, timestep)
     step = 0
@@ -57,12 +58,15 @@ def _episode_summary(series, start=0, end=None) -> dict:
     episode_return = float(np.sum(series["reward"][start:end]))
     if np.all(np.isnan(pe)):  # a domain without a head or target (e.g. reacher): its return is all there is
         return {"return": episode_return, "steps": int(pe.size)}
-    within = (pe <= probes.POSITION_TOLERANCE) & (ae <= probes.ATTITUDE_TOLERANCE)
+    position_tolerance, attitude_tolerance = series.get(
+        "tolerances", (probes.POSITION_TOLERANCE, probes.ATTITUDE_TOLERANCE))
+    within = (pe <= position_tolerance) & (ae <= attitude_tolerance)
     reached = np.flatnonzero(within)
     return {
         "final_position_error": float(pe[-1]), "final_attitude_error": float(ae[-1]),
         "min_position_error": float(pe.min()),
-        "success": probes.is_success(pe[-1], ae[-1]),
+        "success": probes.is_success(pe[-1], ae[-1], position_tolerance, attitude_tolerance),
+        "tolerances": [float(position_tolerance), float(attitude_tolerance)],
         "steps_to_reach": int(reached[0] + 1) if reached.size else None,
         "steps": int(pe.size), "return": episode_return,
     }
@@ -85,7 +89,8 @@ def summarize(episodes) -> dict:
         "attitude_error_median": float(np.median(ae)), "attitude_error_p90": float(np.percentile(ae, 90)),
         "reached_fraction": len(reach) / len(episodes),
         "steps_to_reach_median": float(np.median(reach)) if reach else None,
-        "position_tolerance_m": probes.POSITION_TOLERANCE, "attitude_tolerance_deg": probes.ATTITUDE_TOLERANCE,
+        "position_tolerance_m": episodes[0].get("tolerances", [probes.POSITION_TOLERANCE])[0],
+        "attitude_tolerance_deg": episodes[0].get("tolerances", [0, probes.ATTITUDE_TOLERANCE])[1],
         **return_stats,
     }
 

@@ -108,7 +108,7 @@ class EnvironmentLoop:
                         "env_steps": self.env_steps, "episode": self.episodes,
                         "return": self.episode_return, "length": self.episode_length,
                         "position_error": position_error, "attitude_error": attitude_error,
-                        "success": probes.is_success(position_error, attitude_error),
+                        "success": probes.is_success(position_error, attitude_error, *probes.tolerances(env)),
                         "time": time.time(),
                     })
         return self.env_steps - start

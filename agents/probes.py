@@ -33,5 +33,14 @@ def head_xz(env):
     return None
 
 
-def is_success(position_error, attitude_error) -> bool:
-    return bool(position_error <= POSITION_TOLERANCE and attitude_error <= ATTITUDE_TOLERANCE)
+def tolerances(env):
+    """(position m, attitude deg) the task judges success with: the task's own, so a task built
+    with `position_tolerance=0.02` is scored against 0.02; the paper's 0.05 m and 5 deg otherwise."""
+    task = env.task
+    return (float(getattr(task, "position_tolerance", POSITION_TOLERANCE)),
+            float(getattr(task, "attitude_tolerance", ATTITUDE_TOLERANCE)))
+
+
+def is_success(position_error, attitude_error, position_tolerance=POSITION_TOLERANCE,
+               attitude_tolerance=ATTITUDE_TOLERANCE) -> bool:
+    return bool(position_error <= position_tolerance and attitude_error <= attitude_tolerance)

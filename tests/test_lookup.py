@@ -81,3 +81,21 @@ def test_evaluation_on_reacher_reports_returns_not_nan(tmp_path):
     text = open(os.path.join(tmp_path, "ev", "sac_heldout.json")).read()
     assert "NaN" not in text and json.loads(text)["episodes"][0]["steps"] == 1000
     assert evaluation.evaluate_lookup(str(tmp_path / "ev"), "reacher", "easy", None) is None
+
+
+def test_evaluation_judges_success_with_the_tasks_own_tolerances():
+    """A task built with a 2 cm tolerance is scored against 2 cm, not the paper's 5 cm."""
+    from robostrich_suite import targets
+    from agents.lookup import LookupPolicy
+    from agents.replay import ObservationFlattener
+    import robostrich_suite
+    target = targets.heldout_targets()[:1]  # the lookup holds a neighbour: about a centimetre off
+    results = {}
+    for tolerance in (0.05, 1e-4):
+        env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(
+            random=0, target_pool=target, position_tolerance=tolerance))
+        flattener = ObservationFlattener(env.observation_spec())
+        series = evaluation.rollout(env, LookupPolicy(flattener), flattener)
+        results[tolerance] = evaluation._episode_summary(series)
+    assert results[0.05]["success"] and results[0.05]["tolerances"][0] == 0.05
+    assert not results[1e-4]["success"] and results[1e-4]["tolerances"][0] == 1e-4
