@@ -58,7 +58,8 @@ class GymnasiumEnv(gymnasium.Env):
 
     def to_dm_action(self, action) -> np.ndarray:
         """The dm_env action (contractions in metres) for a gymnasium action."""
-        action = np.asarray(action, dtype=np.float64)
+        from robostrich_suite.reach import validate_action
+        action = validate_action(action, self._action_low.size)
         if not self.normalize_actions:
             return action
         return self._action_low + (action + 1.0) * 0.5 * (self._action_high - self._action_low)

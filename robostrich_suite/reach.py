@@ -35,9 +35,23 @@ INITIAL_STATES = ("fixed", "continue")
 REWARDS = ("lesson1", "lesson2")
 
 
+def validate_action(action, size: int) -> np.ndarray:
+    """``action`` as a float64 vector of ``size`` real numbers, or a ValueError naming what was
+    expected and what came (a scalar must not silently drive every tendon, nor 8 values fail
+    deep inside numpy)."""
+    array = np.asarray(action)
+    if array.dtype.kind not in "iuf":  # not bool, complex, str, object (None), ...
+        raise ValueError(f"action must be {size} real numbers (float), got dtype {array.dtype} "
+                         f"({type(action).__name__})")
+    if array.shape != (size,):
+        raise ValueError(f"action must have shape ({size},), got shape {array.shape}")
+    return array.astype(np.float64)
+
+
 def check_action(action: np.ndarray, control_range: np.ndarray) -> np.ndarray:
-    """Reject NaN/inf actions; clip the rest into ``control_range`` ((n, 2) low/high)."""
-    action = np.asarray(action, dtype=np.float64)
+    """Reject actions of the wrong shape or type and NaN/inf; clip the rest into
+    ``control_range`` ((n, 2) low/high)."""
+    action = validate_action(action, len(control_range))
     if not np.all(np.isfinite(action)):
         bad = np.flatnonzero(~np.isfinite(action)).tolist()
         raise ValueError(f"action has non-finite values at indices {bad}: {action}")

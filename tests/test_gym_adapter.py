@@ -1,5 +1,6 @@
 """The gymnasium adapter exposes the same task with gymnasium's contract."""
 import numpy as np
+import pytest
 from gymnasium.utils.env_checker import check_env
 
 from robostrich_suite import gym_adapter
@@ -37,3 +38,12 @@ def test_normalized_actions_map_onto_the_tendon_range():
     np.testing.assert_allclose(env.dm_env.physics.data.ctrl, (spec.minimum + spec.maximum) / 2)
     raw = gym_adapter.make("robostrich", "lesson1", seed=0, normalize_actions=False)
     np.testing.assert_allclose(raw.action_space.high, spec.maximum.astype(np.float32))
+
+
+def test_gym_step_rejects_actions_of_the_wrong_shape_or_type():
+    env = gym_adapter.make("robostrich", "lesson1", seed=0)
+    env.reset(seed=0)
+    for action, message in ((np.float32(0.5), "shape"), (np.zeros(8, np.float32), "shape"),
+                            (np.array(["x"] * 9), "real numbers")):
+        with pytest.raises(ValueError, match=message):
+            env.step(action)

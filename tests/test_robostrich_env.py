@@ -135,6 +135,25 @@ def test_same_seed_same_actions_same_trajectory():
     assert not np.array_equal(first[0], other[0])  # another seed, another target
 
 
+@pytest.mark.parametrize("domain", ["robostrich", "robostrich_a1"])
+@pytest.mark.parametrize("action, message", [
+    (np.zeros((1, 9)), r"shape \(9,\), got shape \(1, 9\)"),
+    (np.zeros(1), r"shape \(9,\), got shape \(1,\)"),
+    (0.01, r"shape \(9,\), got shape \(\)"),
+    (np.zeros(8), r"got shape \(8,\)"),
+    (np.zeros(10), r"got shape \(10,\)"),
+    (["a"] * 9, r"real numbers .*dtype <U1"),
+    (np.zeros(9, bool), r"dtype bool"),
+    (np.zeros(9, complex), r"dtype complex128"),
+    (None, r"dtype object"),
+])
+def test_malformed_actions_raise_naming_expected_and_received(domain, action, message):
+    env = robostrich_suite.load(domain, "lesson1", task_kwargs=dict(random=0))
+    env.reset()
+    with pytest.raises(ValueError, match=message):
+        env.step(action)
+
+
 def test_nan_action_raises_and_out_of_range_is_clipped():
     env = robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(random=0))
     env.reset()
