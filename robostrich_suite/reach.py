@@ -48,6 +48,26 @@ def validate_action(action, size: int) -> np.ndarray:
     return array.astype(np.float64)
 
 
+def as_targets(targets, name: str) -> np.ndarray:
+    """(n, 2) finite head positions (x, z); one (2,) position is one target. Anything else (a
+    (4, 3) or (1, 4) array) is an error, not silently reshaped into other targets."""
+    array = np.asarray(targets, dtype=np.float64)
+    if array.shape == (2,):
+        array = array[None]
+    if array.ndim != 2 or array.shape[1] != 2 or len(array) == 0:
+        raise ValueError(f"{name} must be a non-empty (n, 2) array of (x, z) positions, got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must hold finite positions")
+    return array
+
+
+def check_time_limit(time_limit) -> float:
+    """A positive number of seconds (inf: no limit); NaN would never end an episode."""
+    if not (float(time_limit) > 0):
+        raise ValueError(f"time_limit must be positive seconds (or inf), got {time_limit}")
+    return float(time_limit)
+
+
 def check_action(action: np.ndarray, control_range: np.ndarray) -> np.ndarray:
     """Reject actions of the wrong shape or type and NaN/inf; clip the rest into
     ``control_range`` ((n, 2) low/high)."""
@@ -88,9 +108,12 @@ class Reach(base.Task):
         if target_pool is None:
             from robostrich_suite import targets
             target_pool = targets.training_targets()
-        target_pool = np.asarray(target_pool, dtype=np.float64).reshape(-1, 2)
-        if len(target_pool) == 0 or not np.all(np.isfinite(target_pool)):
-            raise ValueError("target_pool must be a non-empty (n, 2) array of finite positions")
+        target_pool = as_targets(target_pool, "target_pool")
+        for name, value in (("position_tolerance", position_tolerance), ("attitude_tolerance", attitude_tolerance)):
+            if not (np.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a positive finite number, got {value}")
+        if not np.isfinite(desired_attitude):
+            raise ValueError(f"desired_attitude must be a finite angle in degrees, got {desired_attitude}")
         if isinstance(weights, dict):
             weights = rewards.RewardWeights(**weights)
         self.reward_name = reward
@@ -225,9 +248,9 @@ class Track(Reach):
         if targets is None:
             from robostrich_suite import targets as targets_lib
             targets = default_track_targets(targets_lib.heldout_targets())
-        targets = np.asarray(targets, dtype=np.float64).reshape(-1, 2)
-        if steps_per_target < 1:
-            raise ValueError(f"steps_per_target must be >= 1, got {steps_per_target}")
+        targets = as_targets(targets, "targets")
+        if isinstance(steps_per_target, bool) or int(steps_per_target) != steps_per_target or steps_per_target < 1:
+            raise ValueError(f"steps_per_target must be a whole number of control steps >= 1, got {steps_per_target}")
         kwargs.setdefault("reward", "lesson2")
         super().__init__(target_pool=targets, **kwargs)
         self.targets = targets

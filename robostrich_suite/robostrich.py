@@ -44,6 +44,7 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
 
 
 def _environment(task, time_limit, arm_spec, tendon_layout, environment_kwargs):
+    time_limit = reach.check_time_limit(time_limit)
     physics = Physics.from_xml_string(*get_model_and_assets(arm_spec, tendon_layout))
     environment_kwargs = dict(environment_kwargs or {})
     environment_kwargs.setdefault("control_timestep", CONTROL_TIMESTEP)

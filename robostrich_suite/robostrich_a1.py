@@ -319,7 +319,7 @@ def default_target_pool() -> np.ndarray:
 
 def frame_to_trunk(frame_targets) -> np.ndarray:
     """(x, z) head positions of the arm on its frame -> (forward, up) on the standing A1."""
-    frame_targets = np.asarray(frame_targets, float).reshape(-1, 2)
+    frame_targets = reach.as_targets(frame_targets, "targets")
     return frame_targets + [MOUNT_OFFSET[0], NOMINAL_MOUNT_HEIGHT - FRAME_MOUNT_HEIGHT]
 
 
@@ -491,6 +491,7 @@ class NarrowGap(_QuadrupedTaskMixin, reach.Track):
 # --- environments --------------------------------------------------------------------
 def _environment(task, time_limit, arm_spec, tendon_layout, environment_kwargs,
                  scene="flat"):
+    time_limit = reach.check_time_limit(time_limit)
     physics = Physics.from_xml_string(*get_model_and_assets(arm_spec, tendon_layout, scene))
     environment_kwargs = dict(environment_kwargs or {})
     environment_kwargs.setdefault("control_timestep", CONTROL_TIMESTEP)

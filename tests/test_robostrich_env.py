@@ -273,3 +273,26 @@ def test_attitude_error_and_reward_have_no_jump_under_bang_bang_inputs():
             break
     assert largest_step < 60.0
     assert crossed, "the inputs should swing the head past 180 deg (straight down)"
+
+
+@pytest.mark.parametrize("task, kwargs, message", [
+    ("lesson2", dict(target_pool=np.zeros((4, 3))), r"target_pool must be .*\(n, 2\).*\(4, 3\)"),
+    ("lesson2", dict(target_pool=np.zeros((1, 4))), r"got shape \(1, 4\)"),
+    ("lesson2", dict(target_pool=[[0.3, np.nan]]), "finite"),
+    ("lesson2", dict(position_tolerance=-0.05), "position_tolerance must be a positive"),
+    ("lesson2", dict(attitude_tolerance=float("nan")), "attitude_tolerance must be a positive"),
+    ("lesson2", dict(desired_attitude=float("nan")), "desired_attitude must be a finite"),
+    ("lesson2", dict(time_limit=0.0), "time_limit must be positive"),
+    ("lesson2", dict(time_limit=float("nan")), "time_limit must be positive"),
+    ("track", dict(targets=np.zeros((3, 3))), r"targets must be .*\(3, 3\)"),
+    ("track", dict(steps_per_target=2.5), "steps_per_target"),
+])
+def test_bad_task_options_raise_naming_the_option(task, kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        robostrich_suite.load("robostrich", task, task_kwargs=dict(random=0, **kwargs))
+
+
+def test_one_target_may_be_given_as_a_pair():
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=0, target_pool=[0.3, 0.4]))
+    env.reset()
+    np.testing.assert_array_equal(env.task.target_position, [0.3, 0.4])
