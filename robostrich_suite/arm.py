@@ -109,6 +109,15 @@ class ArmSpec:
         n = len(self.joint_names)
         if n < 2:
             raise ValueError(f"an arm needs at least 2 joints, got {n}")
+        for name in self.joint_names:
+            _check_name(name, "joint/link name")
+        numbers = [(f, getattr(self, f)) for f in ("dorsal_limits_deg", "ventral_limits_deg", "link_lengths",
+                                                    "masses", "limit_solref", "limit_solimp")]
+        numbers += [(f.name, getattr(self, f.name)) for f in dataclasses.fields(self)
+                    if isinstance(getattr(self, f.name), float)]
+        for field, value in numbers:  # NaN and inf pass the sign checks below and fail deep in MuJoCo
+            if not np.all(np.isfinite(np.asarray(value, np.float64))):
+                raise ValueError(f"{field} must be finite, got {value}")
         if len(set(self.joint_names)) != n:
             dup = sorted({x for x in self.joint_names if self.joint_names.count(x) > 1})
             raise ValueError(f"duplicate joint/link names: {dup}")
@@ -142,6 +151,13 @@ class ArmSpec:
         for field in ("hole_fraction", "head_site_fraction"):
             if not 0 <= getattr(self, field) <= 1:
                 raise ValueError(f"{field} must be in [0, 1], got {getattr(self, field)}")
+
+
+def _check_name(name, what: str) -> None:
+    """Names end up in MJCF names and the tab-joined action-spec name: printable, no tab/newline."""
+    if not isinstance(name, str) or not name or not name.isprintable() or name != name.strip():
+        raise ValueError(f"{what} {name!r} must be a non-empty printable string without "
+                         "tabs, newlines or surrounding spaces")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -243,8 +259,7 @@ class TendonLayout:
         order = {name: i for i, name in enumerate(reversed(spec.joint_names))}  # caudal = 0
         seen = set()
         for tendon in self.tendons:
-            if not tendon.name or not isinstance(tendon.name, str):
-                raise ValueError(f"tendon name must be a non-empty string, got {tendon.name!r}")
+            _check_name(tendon.name, "tendon name")
             if tendon.name in seen:
                 raise ValueError(f"duplicate tendon name {tendon.name!r}")
             seen.add(tendon.name)

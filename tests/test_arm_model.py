@@ -127,6 +127,12 @@ def test_generator_takes_another_spec_and_layout():
     (dict(link_lengths=(0.0071, 0.0) + (0.04,) * 15), "link 'c3': length"),
     (dict(link_lengths=(0.01,) * 3), "link_lengths has 3 entries"),
     (dict(joint_names=("atlas",) + ("c2",) * 17), "duplicate joint/link names"),
+    (dict(joint_stiffness=float("nan")), "joint_stiffness must be finite"),
+    (dict(joint_damping=float("nan")), "joint_damping must be finite"),
+    (dict(masses=(float("inf"),) + (0.01,) * 17), "masses must be finite"),
+    (dict(tendon_kp=float("inf")), "tendon_kp must be finite"),
+    (dict(anchor_depth=float("nan")), "anchor_depth must be finite"),
+    (dict(joint_names=("",) + tuple(f"c{i}" for i in range(2, 19))), "joint/link name '' must be"),
 ])
 def test_bad_spec_raises_naming_the_item(change, message):
     spec = dataclasses.replace(arm.ArmSpec.from_table1(), **change)
@@ -142,6 +148,7 @@ def test_bad_spec_raises_naming_the_item(change, message):
     ((arm.TendonSpec("t", "lateral", ("c18", "c17")),), "unknown side 'lateral'"),
     ((arm.TendonSpec("t", "ventral", ("c17", "c18")),), "caudal to cranial"),
     ((), "at least one tendon"),
+    ((arm.TendonSpec("dorsal\tx", "dorsal", ("c18", "c17")),), "tendon name 'dorsal.*' must be a non-empty printable"),
 ])
 def test_bad_layout_raises_naming_the_item(tendons, message):
     with pytest.raises(ValueError, match=message):
