@@ -53,7 +53,13 @@ class GymnasiumEnv(gymnasium.Env):
         super().reset(seed=seed)
         if seed is not None:
             self.dm_env.task.random.seed(seed)
+            # A seeded reset is a fresh start: lesson 3 must not carry over the last pose,
+            # or two resets with one seed would differ (gymnasium's determinism check).
+            forget = getattr(self.dm_env.task, "forget_last_state", None)
+            if forget is not None:
+                forget()
         timestep = self.dm_env.reset()
+        self._episode_over = False
         return self._flatten(timestep.observation), {}
 
     def to_dm_action(self, action) -> np.ndarray:
@@ -65,7 +71,11 @@ class GymnasiumEnv(gymnasium.Env):
         return self._action_low + (action + 1.0) * 0.5 * (self._action_high - self._action_low)
 
     def step(self, action):
+        if getattr(self, "_episode_over", True):
+            raise gymnasium.error.ResetNeeded(
+                "cannot call step() before reset() or after the episode ended; call reset()")
         timestep = self.dm_env.step(self.to_dm_action(action))
+        self._episode_over = timestep.last()
         terminated = timestep.last() and timestep.discount == 0.0
         truncated = timestep.last() and not terminated
         info = {}

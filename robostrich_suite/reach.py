@@ -146,6 +146,10 @@ class Reach(base.Task):
         self.target_position = self.next_target()
         super().initialize_episode(physics)
 
+    def forget_last_state(self) -> None:
+        """The next "continue" episode starts from the fixed pose (as after a divergence)."""
+        self._last_state = None
+
     def next_target(self) -> np.ndarray:
         return self.target_pool[self.random.randint(len(self.target_pool))].copy()
 

@@ -47,3 +47,27 @@ def test_gym_step_rejects_actions_of_the_wrong_shape_or_type():
                             (np.array(["x"] * 9), "real numbers")):
         with pytest.raises(ValueError, match=message):
             env.step(action)
+
+
+def test_lesson3_passes_gymnasiums_checker_and_seeded_resets_start_alike():
+    """A seeded reset forgets lesson 3's carried-over pose, so equal seeds give equal episodes."""
+    env = gym_adapter.make("robostrich", "lesson3", seed=0, time_limit=0.08)
+    check_env(env, skip_render_check=True)
+    first, _ = env.reset(seed=5)
+    for _ in range(5):
+        env.step(np.ones(9, np.float32))
+    again, _ = env.reset(seed=5)
+    np.testing.assert_array_equal(first, again)
+
+
+def test_step_after_the_episode_ended_asks_for_a_reset():
+    import gymnasium
+    env = gym_adapter.make("robostrich", "lesson1", seed=0, time_limit=0.016)
+    with pytest.raises(gymnasium.error.ResetNeeded):
+        env.step(np.zeros(9, np.float32))
+    env.reset(seed=0)
+    env.step(np.zeros(9, np.float32))
+    _, _, _, truncated, _ = env.step(np.zeros(9, np.float32))
+    assert truncated
+    with pytest.raises(gymnasium.error.ResetNeeded, match="reset"):
+        env.step(np.zeros(9, np.float32))
