@@ -247,6 +247,8 @@ class TrunkHeightSchedule:
         times, heights = np.asarray(self.times, float), np.asarray(self.heights, float)
         if times.shape != heights.shape or times.ndim != 1 or len(times) == 0:
             raise ValueError("times and heights must be 1-D sequences of the same, non-zero length")
+        if not np.all(np.isfinite(times)):
+            raise ValueError(f"schedule times must be finite, got {self.times}")
         if np.any(np.diff(times) <= 0):
             raise ValueError(f"schedule times must increase strictly, got {self.times}")
         check_trunk_height(heights)
@@ -292,7 +294,15 @@ def read_gait_file(path) -> tuple[np.ndarray, np.ndarray]:
     path = pathlib.Path(path)
     rows, values = [], []
     header_seen = False
-    with open(path, newline="") as handle:
+    if not path.is_file():
+        raise ValueError(f"{path}: no such gait file")
+    try:  # utf-8-sig: a byte-order mark (spreadsheet exports) is not part of 'time'
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as error:
+        raise ValueError(f"{path}: not a text (UTF-8) gait file: byte {error.start} cannot be decoded") from None
+    if "\0" in text:
+        raise ValueError(f"{path}: not a text gait file (it contains NUL bytes)")
+    with io.StringIO(text, newline="") as handle:
         for line_number, row in enumerate(csv.reader(handle), start=1):
             if not row or not "".join(row).strip() or row[0].lstrip().startswith("#"):
                 continue
@@ -302,12 +312,13 @@ def read_gait_file(path) -> tuple[np.ndarray, np.ndarray]:
                                  f"{len(COLUMNS)} (time + 12 joint targets)")
             if not header_seen:
                 header_seen = True
-                if cells[0].lower() == "time":
-                    if tuple(cells) != COLUMNS:
-                        wrong = next(i for i, (a, b) in enumerate(zip(cells, COLUMNS)) if a != b)
-                        raise ValueError(f"{path}: line {line_number}, column {wrong + 1}: header "
-                                         f"{cells[wrong]!r}, expected {COLUMNS[wrong]!r}")
-                    continue
+                if tuple(cells) != COLUMNS:  # the header names the columns: required, so a file
+                    # whose columns are in another order cannot be replayed silently
+                    wrong = next(i for i, (a, b) in enumerate(zip(cells, COLUMNS)) if a != b)
+                    raise ValueError(f"{path}: line {line_number}, column {wrong + 1}: header "
+                                     f"{cells[wrong]!r}, expected {COLUMNS[wrong]!r} (the first row "
+                                     f"must name the columns: {','.join(COLUMNS)})")
+                continue
             try:
                 numbers = [float(cell) for cell in cells]
             except ValueError:

@@ -125,6 +125,17 @@ def plot_walk(series: dict, path, title: str = "") -> None:
     plt.close(fig)
 
 
+def _at_least_one_step(text: str) -> float:
+    import argparse
+    try:
+        seconds = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid number: {text!r}") from None
+    if not seconds >= CONTROL_TIMESTEP:  # also NaN
+        raise argparse.ArgumentTypeError(f"must be at least one control step ({CONTROL_TIMESTEP} s), got {text}")
+    return seconds
+
+
 def main(argv=None) -> None:
     """The walk tool: trot with scripted tendons, write a Rerun recording and a PNG."""
     parser = argparse.ArgumentParser(
@@ -132,7 +143,8 @@ def main(argv=None) -> None:
                     "(trunk and head height, speed and attitude over time).")
     parser.add_argument("--task", default="head_stabilize", choices=list(SUITE),
                         help="robostrich_a1 task whose gait and trunk heights to run")
-    parser.add_argument("--seconds", type=float, default=12.0)
+    parser.add_argument("--seconds", type=_at_least_one_step, default=12.0,
+                        help="simulated time, at least one control step (default: %(default)s)")
     parser.add_argument("--tendons", default="zero", choices=["zero", "sine"],
                         help="scripted tendon input (zero: the passive neck)")
     parser.add_argument("--gait", default=None,

@@ -168,3 +168,35 @@ def test_trunk_height_schedule_interpolates_and_holds():
         gait.TrunkHeightSchedule((0, 0), (0.27, 0.27))
     with pytest.raises(ValueError, match="outside the range"):
         gait.TrunkHeightSchedule((0, 1), (0.27, 0.5))
+
+
+def test_gait_file_problems_are_value_errors_naming_the_file(tmp_path):
+    missing = tmp_path / "missing.csv"
+    with pytest.raises(ValueError, match="no such gait file"):
+        gait.read_gait_file(missing)
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(bytes(range(256)))
+    with pytest.raises(ValueError, match="not a text"):
+        gait.read_gait_file(binary)
+    times, targets = gait.read_gait_file(gait.DATA_PATH)  # the shipped sample still reads
+    assert len(times) == len(targets) > 2
+
+
+def test_gait_file_needs_its_header_and_tolerates_a_byte_order_mark(tmp_path):
+    good = tmp_path / "good.csv"
+    times = np.array([0.0, 0.5, 1.0])
+    targets = np.tile([0.0, 0.9, -1.8] * 4, (3, 1))
+    gait.write_gait_file(good, times, targets)
+    text = good.read_text()
+    bom = tmp_path / "bom.csv"
+    bom.write_text("\ufeff" + text, encoding="utf-8")
+    np.testing.assert_array_equal(gait.read_gait_file(bom)[0], times)
+    headless = tmp_path / "headless.csv"
+    headless.write_text("\n".join(l for l in text.splitlines() if not l.startswith("time")) + "\n")
+    with pytest.raises(ValueError, match=r"line 1, column 1: header '0\.0+', expected 'time' .the first row must name the columns"):
+        gait.read_gait_file(headless)
+
+
+def test_trunk_height_schedule_rejects_nan_times():
+    with pytest.raises(ValueError, match="finite"):
+        gait.TrunkHeightSchedule(times=(0.0, float("nan")), heights=(0.27, 0.25))
