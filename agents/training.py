@@ -1,6 +1,6 @@
 """The main job: curriculum SAC (lessons 1->3) and a plain-SAC baseline, then evaluation, figures and recordings.
 
-    robostrich-train                               # defaults: writes runs/default, ~20 min on 2 CPU cores
+    robostrich-train                               # defaults: writes runs/default, ~13 min on 2 CPU cores
     robostrich-train --out runs/default --resume   # continue a killed run from its last checkpoints
 
 Run directory:
