@@ -123,7 +123,9 @@ def main(argv=None):
     args = p.parse_args(argv)
     env = make_environment(args.domain, args.task, 0)
     config = SACConfig(batch_size=args.batch, hidden_sizes=tuple(int(h) for h in args.hidden.split(",")),
-                       updates_per_call=args.updates_per_call, min_replay_size=0)
+                       updates_per_call=args.updates_per_call, min_replay_size=0,
+                       # the same computation as the plain implementation it is compared with
+                       critic_layer_norm=False, her_ratio=0.0, relabel_rewards=False)
     loop = SACBuilder(config).make_components(env, seed=0)
     obs_size, act_size = loop.flattener.size, loop.actor.adapter.size
     networks = make_networks(obs_size, act_size, config.hidden_sizes)
