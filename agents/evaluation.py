@@ -58,8 +58,7 @@ def _episode_summary(series, start=0, end=None) -> dict:
     episode_return = float(np.sum(series["reward"][start:end]))
     if np.all(np.isnan(pe)):  # a domain without a head or target (e.g. reacher): its return is all there is
         return {"return": episode_return, "steps": int(pe.size)}
-    position_tolerance, attitude_tolerance = series.get(
-        "tolerances", (probes.POSITION_TOLERANCE, probes.ATTITUDE_TOLERANCE))
+    position_tolerance, attitude_tolerance = series["tolerances"]
     within = (pe <= position_tolerance) & (ae <= attitude_tolerance)
     reached = np.flatnonzero(within)
     return {
@@ -89,8 +88,8 @@ def summarize(episodes) -> dict:
         "attitude_error_median": float(np.median(ae)), "attitude_error_p90": float(np.percentile(ae, 90)),
         "reached_fraction": len(reach) / len(episodes),
         "steps_to_reach_median": float(np.median(reach)) if reach else None,
-        "position_tolerance_m": episodes[0].get("tolerances", [probes.POSITION_TOLERANCE])[0],
-        "attitude_tolerance_deg": episodes[0].get("tolerances", [0, probes.ATTITUDE_TOLERANCE])[1],
+        "position_tolerance_m": episodes[0]["tolerances"][0],
+        "attitude_tolerance_deg": episodes[0]["tolerances"][1],
         **return_stats,
     }
 
@@ -243,11 +242,16 @@ def evaluate_lookup(out_dir: str, domain: str, heldout_task: str, track_task: Op
                           num_targets, env_steps=0, record=record, action_repeat=1)
 
 
-def write_json(path: str, obj) -> None:
+def write_text(path: str, text: str) -> None:
+    """Readers never see a half-written file: write beside it, then rename."""
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
-        json.dump(obj, f, indent=1, default=_json_default)
+        f.write(text)
     os.replace(tmp, path)
+
+
+def write_json(path: str, obj) -> None:
+    write_text(path, json.dumps(obj, indent=1, default=_json_default))
 
 
 def _json_default(o):

@@ -20,8 +20,8 @@ import numpy as np
 class GoalRelabeler:
     """Overwrites the goal of flat observations and recomputes the task's reward."""
 
-    def __init__(self, flattener, task):
-        slices = _slices(flattener)
+    def __init__(self, flattener, task, slices: Optional[dict] = None):
+        slices = _slices(flattener) if slices is None else slices
         self.goal = slices[task.GOAL_OBSERVATION]
         self.achieved = slices[task.ACHIEVED_OBSERVATION]
         self.delta = slices.get(task.GOAL_DELTA_OBSERVATION)
@@ -42,7 +42,7 @@ class GoalRelabeler:
             return None
         if goal.stop - goal.start != achieved.stop - achieved.start:
             return None  # e.g. a 3-D head position against a 2-D target
-        return cls(flattener, task)
+        return cls(flattener, task, slices)
 
     def substep(self, flat_obs: np.ndarray) -> np.ndarray:
         """(achieved goal..., attitude error in deg) of one control step's flat observation."""

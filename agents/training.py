@@ -33,6 +33,11 @@ DEFAULT_TOTAL_STEPS = 240_000  # per run: 80k control steps per lesson; the two 
 DEFAULT_LESSONS = ("lesson1", "lesson2", "lesson3")
 
 
+def lesson_text(run) -> str:
+    """'2/3': the lesson a run is in, for the progress bar."""
+    return f"{run.lesson_index + 1 if not run.done else len(run.plan)}/{len(run.plan)}"
+
+
 class Progress:
     """tqdm bar over all environment steps of all runs: steps/s, run, lesson, recent return and success."""
 
@@ -49,11 +54,15 @@ class Progress:
         self.successes.append(float(record["success"]))
 
     def update(self, n, run):
+        self.advance(n, run.name, lesson_text(run))
+
+    def advance(self, n, label: str, lesson: str):
+        """n more steps of run `label`, now in `lesson` (also what worker processes report)."""
         if self.bar is None:
             return
         self.bar.update(n)
-        self.bar.set_postfix(run=run.name, lesson=f"{run.lesson_index + 1 if not run.done else len(run.plan)}"
-                             f"/{len(run.plan)}", ret=f"{np.mean(self.returns) if self.returns else float('nan'):.1f}",
+        self.bar.set_postfix(run=label, lesson=lesson,
+                             ret=f"{np.mean(self.returns) if self.returns else float('nan'):.1f}",
                              succ=f"{np.mean(self.successes) if self.successes else float('nan'):.2f}",
                              refresh=False)
 
@@ -129,12 +138,17 @@ _FLAG_ALIASES = {"hidden_sizes": ("--hidden",), "min_replay_size": ("--min-repla
                  "max_replay_size": ("--replay-size",)}
 
 
+def _config_flags(field_name: str) -> tuple:
+    """The flags of one SACConfig field: ``--field-name`` and any older spelling."""
+    return ("--" + field_name.replace("_", "-"),) + _FLAG_ALIASES.get(field_name, ())
+
+
 def add_config_arguments(group, defaults: SACConfig = SACConfig()):
     """One flag per SACConfig field (``--field-name``), its default read from the dataclass: the
     dataclass is the one home of the training defaults, the CLI only exposes them."""
     for field in dataclasses.fields(SACConfig):
         default = getattr(defaults, field.name)
-        flags = ("--" + field.name.replace("_", "-"),) + _FLAG_ALIASES.get(field.name, ())
+        flags = _config_flags(field.name)
         help_text = f"(default: {default if not isinstance(default, tuple) else ','.join(map(str, default))})"
         if isinstance(default, bool):
             group.add_argument(*flags, dest=field.name, action=argparse.BooleanOptionalAction,
@@ -166,10 +180,10 @@ def _explicit_fields(argv) -> set:
     argv = sys.argv[1:] if argv is None else list(argv)
     named = set()
     for field in dataclasses.fields(SACConfig):
-        flags = ("--" + field.name.replace("_", "-"),) + _FLAG_ALIASES.get(field.name, ())
+        flags = _config_flags(field.name)
         for token in argv:
             option = token.split("=", 1)[0]
-            if option in flags or option == "--no-" + field.name.replace("_", "-"):
+            if option in flags or option == "--no-" + flags[0][2:]:
                 named.add(field.name)
     return named
 
@@ -245,8 +259,7 @@ class _QueueProgress:
         self.queue.put(("episode", self.label, {"return": record["return"], "success": record["success"]}))
 
     def update(self, n, run):
-        lesson = f"{run.lesson_index + 1 if not run.done else len(run.plan)}/{len(run.plan)}"
-        self.queue.put(("steps", self.label, (n, lesson)))
+        self.queue.put(("steps", self.label, (n, lesson_text(run))))
 
     def reset_window(self):
         pass
@@ -271,6 +284,7 @@ def _train_in_parallel(runs: dict, job: RunJob, progress, workers: int) -> dict:
     independent, so on two cores the main job takes the time of one run. Workers restore from and
     write the same checkpoints as a sequential run, so results are identical and resumable."""
     import multiprocessing
+    import queue as queue_lib
     context = multiprocessing.get_context("spawn")
     queue = context.Queue()
     # One intra-op thread per worker; set before the spawned interpreters import JAX.
@@ -291,17 +305,14 @@ def _train_in_parallel(runs: dict, job: RunJob, progress, workers: int) -> dict:
                 active[label] = process
             try:
                 kind, label, payload = queue.get(timeout=1.0)
-            except Exception:  # queue.Empty: check for workers that died without a word
+            except queue_lib.Empty:  # check for workers that died without a word
                 for label, process in list(active.items()):
                     if not process.is_alive() and label not in outcomes:
                         errors.setdefault(label, f"worker exited with status {process.exitcode}")
                         del active[label]
                 continue
             if kind == "steps":
-                n, lesson = payload
-                if progress.bar is not None:
-                    progress.bar.update(n)
-                    progress.bar.set_postfix(run=label, lesson=lesson, refresh=False)
+                progress.advance(payload[0], label, payload[1])
             elif kind == "episode":
                 progress.on_episode(payload)
             elif kind == "done":

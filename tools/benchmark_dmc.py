@@ -121,11 +121,8 @@ def format_table(rows) -> str:
 
 
 def write_atomic(path: str, text: str) -> None:
-    """Readers never see a half-written file: write beside it, then rename."""
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    from agents.evaluation import write_text  # the project's one atomic writer
+    write_text(path, text)
 
 
 def train_and_evaluate(task, seed, steps, eval_at, config, args, progress, on_row):

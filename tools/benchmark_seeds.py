@@ -109,11 +109,8 @@ def _join(values):
 
 
 def write_atomic(path: str, text: str) -> None:
-    """Readers never see a half-written file: write beside it, then rename."""
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    from agents.evaluation import write_text  # the project's one atomic writer
+    write_text(path, text)
 
 
 def run_seed(seed: int, seed_dir: str, passthrough) -> float:
