@@ -16,11 +16,37 @@ from robostrich_suite import arm as arm_lib
 
 _PREFIX = arm_lib.ARM_MODEL_NAME + "/"
 
+_log = logging.getLogger(__name__)
+
+
+class _MujocoWarningCapture(logging.Filter):
+    """Holds back MuJoCo's own warning lines (dm_control sends them to the ``absl``
+    logger) while an arm steps, so that a divergence is reported in one line that
+    quotes them, instead of one line per MuJoCo warning plus ours."""
+
+    def __init__(self):
+        super().__init__()
+        self.active = False
+        self.messages: list[str] = []
+
+    def filter(self, record):
+        if not self.active:
+            return True
+        self.messages.append(record.getMessage())
+        return False
+
+
+_MUJOCO_WARNINGS = _MujocoWarningCapture()
+logging.getLogger("absl").addFilter(_MUJOCO_WARNINGS)
+
 
 class ArmPhysicsMixin:
     """Accessors for the arm's head, joints and tendons, plus divergence capture."""
 
     divergence: str | None = None
+    # Episodes started and episodes that diverged, for the one log line per divergence.
+    episodes_started: int = 0
+    episodes_diverged: int = 0
 
     # Indices are looked up once per model; the model never changes under a Physics.
     def _arm_indices(self):
@@ -109,9 +135,13 @@ class ArmPhysicsMixin:
         self.data.ctrl[self._arm_indices()[2]] = action
 
     def step(self, nstep: int = 1) -> None:
-        """Step, but turn a divergence into a flag the task ends the episode on."""
+        """Step, but turn a divergence into a flag the task ends the episode on.
+
+        A divergence ends the episode, so it is logged once per episode: one line
+        with MuJoCo's own warnings and how many episodes have diverged so far."""
         if self.divergence is not None:
             return
+        _MUJOCO_WARNINGS.active, _MUJOCO_WARNINGS.messages = True, []
         try:
             super().step(nstep)
         except control.PhysicsError as error:
@@ -119,8 +149,17 @@ class ArmPhysicsMixin:
         else:
             if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
                 self.divergence = "non-finite joint state"
+        finally:
+            _MUJOCO_WARNINGS.active = False
         if self.divergence is not None:
-            logging.warning("physics diverged, ending the episode: %s", self.divergence)
+            self._log_divergence(_MUJOCO_WARNINGS.messages)
+
+    def _log_divergence(self, mujoco_messages: list[str]) -> None:
+        self.episodes_diverged += 1
+        episodes = max(self.episodes_started, 1)
+        detail = " ".join(mujoco_messages) or self.divergence
+        _log.warning("physics diverged in episode %d, ending it (%d of %d episodes diverged "
+                     "so far): %s", episodes, self.episodes_diverged, episodes, detail)
 
     def __setstate__(self, state):
         super().__setstate__(state)
@@ -132,4 +171,5 @@ class ArmPhysicsMixin:
 
     def reset(self, keyframe_id=None):
         self.divergence = None
+        self.episodes_started += 1
         return super().reset(keyframe_id)

@@ -7,7 +7,7 @@ from absl.testing import absltest
 from dm_env import test_utils
 
 import robostrich_suite
-from robostrich_suite import rewards, targets
+from robostrich_suite import arm, rewards, targets
 
 TASKS = robostrich_suite.TASKS_BY_DOMAIN["robostrich"]
 
@@ -180,6 +180,33 @@ def test_divergence_ends_the_episode_with_a_logged_reason(caplog):
     assert "diverged" in caplog.text
     ts = env.step(np.zeros(9))  # the next step starts a fresh, finite episode
     assert ts.first() and np.all(np.isfinite(env.physics.data.qpos))
+
+
+def _records_of_divergence(caplog):
+    return [r for r in caplog.records if "diverged" in r.getMessage()]
+
+
+@pytest.mark.parametrize("domain", ["robostrich", "robostrich_a1"])
+def test_a_stiff_arm_diverges_and_each_episode_logs_it_once_with_a_count(domain, caplog):
+    # Joints 10^6 times stiffer than the real ones blow up within the first control step.
+    stiff_arm = arm.ArmSpec.from_table1(joint_stiffness=1e6)
+    with pytest.warns(UserWarning, match="another arm|default arm"):
+        env = robostrich_suite.load(domain, "lesson2", task_kwargs=dict(
+            random=0, arm_spec=stiff_arm, time_limit=1.0))
+    spec = env.action_spec()
+    with caplog.at_level(logging.WARNING):
+        for episode in (1, 2, 3):
+            caplog.clear()
+            ts = env.reset()
+            while not ts.last():
+                ts = env.step(spec.maximum)
+            assert ts.discount == 0.0
+            lines = _records_of_divergence(caplog)
+            assert len(lines) == 1, [r.getMessage() for r in caplog.records]
+            assert f"in episode {episode}, ending it ({episode} of {episode} episodes" \
+                in lines[0].getMessage()
+            assert "QACC" in lines[0].getMessage()  # MuJoCo's own warning, quoted in the line
+            assert not [r for r in caplog.records if r.name == "absl"]
 
 
 def test_lesson2_starts_fixed_and_lesson3_continues():
