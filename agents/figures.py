@@ -1,13 +1,21 @@
-"""PNG figures in the manner of the paper's Fig. 7 (matplotlib, Agg backend: no display needed)."""
+"""PNG figures in the manner of the paper's Fig. 7 (matplotlib, Agg backend: no display needed).
+
+``learning_curves_figure`` and ``track_figure`` return the Figure (so tests can read
+what a reader sees); ``plot_learning_curves`` and ``plot_track`` write it as a PNG.
+"""
 from typing import Dict, List
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.transforms as mtransforms  # noqa: E402
 import numpy as np  # noqa: E402
 
 from agents import probes  # noqa: E402
+
+# A rate: always its whole range, so 0 % reads as 0 %; room above 1 for the lesson names.
+SUCCESS_LIMITS = (-0.03, 1.1)
 
 
 def _smooth(x, n):
@@ -22,81 +30,189 @@ def _smooth(x, n):
     return out
 
 
-def plot_learning_curves(runs: Dict[str, List[dict]], evals: Dict[str, List[dict]], path: str,
-                         lesson_boundaries=None, baselines: Dict[str, dict] = None):
-    """Fig. 7b: training return and success per episode, and held-out position error, curriculum vs SAC.
+def _save(fig, path: str) -> None:
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _tolerances(summaries) -> tuple:
+    """(position m, attitude deg) the reports were judged with; the paper's when they do not say."""
+    for summary in summaries:
+        if summary and "position_tolerance_m" in summary:
+            return summary["position_tolerance_m"], summary.get("attitude_tolerance_deg",
+                                                                 probes.ATTITUDE_TOLERANCE)
+    return probes.POSITION_TOLERANCE, probes.ATTITUDE_TOLERANCE
+
+
+def _lesson_names(runs: Dict[str, List[dict]], count: int) -> List[str]:
+    """The curriculum's lesson tasks in order, from the run whose records span ``count`` lessons."""
+    for records in runs.values():
+        names = list(dict.fromkeys(r["task"] for r in records if "task" in r))
+        if len(names) == count:
+            return names
+    return []
+
+
+def _mark_lessons(axes, boundaries, names, last_step) -> None:
+    """Dashed line at each lesson change (one legend entry); lesson names along the top."""
+    for ax in axes:
+        for i, b in enumerate(boundaries):
+            ax.axvline(b, color="grey", lw=0.7, ls="--", label="lesson change" if i == 0 else None)
+    if not names:
+        return
+    edges = [0.0, *boundaries, last_step]
+    for ax in axes:
+        low, high = ax.get_ylim()
+        ax.set_ylim(low, high + 0.08 * (high - low))  # headroom: names above the data
+        top = mtransforms.blended_transform_factory(ax.transData, ax.transAxes)
+        for name, left, right in zip(names, edges[:-1], edges[1:]):
+            ax.text((left + right) / 2, 0.98, name, transform=top, ha="center", va="top",
+                    fontsize=8, color="0.35")
+
+
+def learning_curves_figure(runs: Dict[str, List[dict]], evals: Dict[str, List[dict]],
+                           lesson_boundaries=None, baselines: Dict[str, dict] = None):
+    """Fig. 7b: (a) training return and (b) success per episode, (c) held-out position error,
+    curriculum vs SAC.
 
     `baselines` (label -> held-out summary, e.g. the lookup's) are dashed horizontal lines: the bar to clear.
     Domains without position errors (e.g. reacher) show the evaluation return instead.
     """
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
     labels = list(dict.fromkeys(list(runs) + list(evals or {}) + list(baselines or {})))
     color = {label: f"C{i}" for i, label in enumerate(labels)}
+    last_step = 0
     for label, records in runs.items():
         if not records:
             continue
         steps = [r["env_steps"] for r in records]
+        last_step = max(last_step, steps[-1])
         w = max(1, len(records) // 50)
         axes[0].plot(steps, _smooth([r["return"] for r in records], w), color=color[label], label=label)
         axes[1].plot(steps, _smooth([float(r["success"]) for r in records], w), color=color[label], label=label)
-    has_errors = True
-    for label, records in (evals or {}).items():
-        if records:
-            steps = [r["env_steps"] for r in records]
-            if "position_error_median" not in records[0]["summary"]:
-                has_errors = False
-                axes[2].plot(steps, [r["summary"]["return_mean"] for r in records], "o-", color=color[label],
-                             label=f"{label} mean return")
-                continue
-            axes[2].plot(steps, [r["summary"]["position_error_median"] for r in records], "o-", color=color[label],
-                         label=f"{label} median")
-            axes[2].plot(steps, [r["summary"]["position_error_p90"] for r in records], "x--", color=color[label],
-                         label=f"{label} p90")
+    has_errors = _plot_heldout(axes[2], evals or {}, color)
     for label, summary in (baselines or {}).items():
         axes[1].axhline(summary["success_rate"], color=color[label], ls="--", label=f"{label} held-out success")
-        axes[2].axhline(summary["position_error_median"], color=color[label], ls="--",
-                        label=f"{label} held-out median")
+        if has_errors:
+            axes[2].axhline(summary["position_error_median"], color=color[label], ls="--",
+                            label=f"{label} held-out median")
     if has_errors:
-        axes[2].axhline(probes.POSITION_TOLERANCE, color="k", lw=0.8, ls=":")
+        summaries = [r["summary"] for records in (evals or {}).values() for r in records]
+        tolerance = _tolerances(summaries + list((baselines or {}).values()))[0]
+        axes[2].axhline(tolerance, color="k", lw=0.8, ls=":",
+                        label=f"position tolerance ({1000 * tolerance:.0f} mm)")
+        axes[2].set_ylim(bottom=0.0)
+    boundaries = list(lesson_boundaries or [])
+    _mark_lessons(axes, boundaries, _lesson_names(runs, len(boundaries) + 1), last_step)
+    axes[1].set_ylim(*SUCCESS_LIMITS)
     for ax in axes:
-        for b in lesson_boundaries or []:
-            ax.axvline(b, color="grey", lw=0.6, ls="--")
         ax.set_xlabel("environment steps")
         ax.ticklabel_format(axis="x", style="sci", scilimits=(3, 3))  # "x10^3": no overlapping labels
-        ax.legend(fontsize=8)
-    axes[0].set_ylabel("episode return (training)")
-    axes[1].set_ylabel("success rate (training episodes)")
-    axes[2].set_ylabel("held-out final position error (m)" if has_errors else "evaluation episode return")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="best")
+    axes[0].set_title("(a) training episode return", fontsize=10)
+    axes[0].set_ylabel("episode return")
+    axes[1].set_title("(b) training success rate (smoothed)", fontsize=10)
+    axes[1].set_ylabel("fraction of training episodes")
+    if has_errors:
+        axes[2].set_title("(c) held-out final position error", fontsize=10)
+        axes[2].set_ylabel("position error (m)")
+    else:
+        axes[2].set_title("(c) held-out evaluation return", fontsize=10)
+        axes[2].set_ylabel("episode return")
+    fig.suptitle("Learning curves: " + " vs ".join(runs) + " (lessons separated by dashed lines)",
+                 fontsize=11)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    return fig
 
 
-def plot_track(reports: Dict[str, dict], path: str):
-    """Fig. 7a, c, d: head path, position error and head attitude over the `track` task."""
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4))
-    for label, report in reports.items():
+def _plot_heldout(ax, evals: Dict[str, List[dict]], color) -> bool:
+    """Held-out median and p90 position error per evaluation; False (returns drawn) without errors."""
+    has_errors = True
+    for label, records in evals.items():
+        if not records:
+            continue
+        steps = [r["env_steps"] for r in records]
+        if "position_error_median" not in records[0]["summary"]:
+            has_errors = False
+            ax.plot(steps, [r["summary"]["return_mean"] for r in records], "o-", color=color[label],
+                    label=f"{label} mean return")
+            continue
+        ax.plot(steps, [r["summary"]["position_error_median"] for r in records], "o-", color=color[label],
+                label=f"{label} median")
+        ax.plot(steps, [r["summary"]["position_error_p90"] for r in records], "x--", color=color[label],
+                label=f"{label} p90")
+    return has_errors
+
+
+def plot_learning_curves(runs: Dict[str, List[dict]], evals: Dict[str, List[dict]], path: str,
+                         lesson_boundaries=None, baselines: Dict[str, dict] = None):
+    """Write :func:`learning_curves_figure` to ``path`` (PNG)."""
+    _save(learning_curves_figure(runs, evals, lesson_boundaries, baselines), path)
+
+
+def _target_changes(report: dict) -> List[float]:
+    """Times (s) at which the track moves on to its next target."""
+    time = report["series"]["time"]
+    starts = [seg.get("start_step") for seg in report["segments"][1:]]
+    return [time[s] for s in starts if s is not None and 0 <= s < len(time)]
+
+
+def _plot_targets_in_order(ax, report: dict) -> None:
+    """The targets as numbered stars joined in the order the head must visit them."""
+    targets = [seg["target"] for seg in report["segments"] if seg.get("target") is not None]
+    if not targets:
+        return
+    tg = np.asarray(targets)
+    ax.plot(tg[:, 0], tg[:, 1], "--", color="r", lw=0.8, alpha=0.6)
+    ax.plot(tg[:, 0], tg[:, 1], "r*", ms=13, label="targets, in order")
+    for number, (x, z) in enumerate(tg, start=1):
+        ax.annotate(str(number), (x, z), xytext=(6, 6), textcoords="offset points", color="r",
+                    fontsize=10, fontweight="bold")
+
+
+def track_figure(reports: Dict[str, dict]):
+    """Fig. 7a, c, d: (a) head path, (b) position error and (c) head attitude over the `track` task."""
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    for i, (label, report) in enumerate(reports.items()):
         s = report["series"]
         t = np.asarray(s["time"])
         if s.get("head_position"):
             hp = np.asarray(s["head_position"])
-            axes[0].plot(hp[:, 0], hp[:, 1], label=label)
-        axes[1].plot(t, s["position_error"], label=label)
+            axes[0].plot(hp[:, 0], hp[:, 1], color=f"C{i}", label=label)
+            axes[0].plot(*hp[0], "o", color=f"C{i}", mfc="w", ms=7)
+        axes[1].plot(t, s["position_error"], color=f"C{i}", label=label)
         if s.get("head_attitude"):
-            axes[2].plot(t, s["head_attitude"], label=label)
+            axes[2].plot(t, s["head_attitude"], color=f"C{i}", label=label)
     any_report = next(iter(reports.values()))
-    targets = [seg["target"] for seg in any_report["segments"] if seg.get("target") is not None]
-    if targets:
-        tg = np.asarray(targets)
-        axes[0].plot(tg[:, 0], tg[:, 1], "r*", ms=12, label="targets")
-    axes[0].set_xlabel("x (m)"); axes[0].set_ylabel("z (m)"); axes[0].set_aspect("equal", "datalim")
-    axes[1].axhline(probes.POSITION_TOLERANCE, color="k", lw=0.8, ls=":")
+    axes[0].plot([], [], "o", color="k", mfc="w", label="start")
+    _plot_targets_in_order(axes[0], any_report)
+    position_tolerance, attitude_tolerance = _tolerances(r.get("summary") for r in reports.values())
+    axes[1].axhline(position_tolerance, color="k", lw=0.8, ls=":",
+                    label=f"position tolerance ({1000 * position_tolerance:.0f} mm)")
+    axes[1].set_ylim(bottom=0.0)
+    axes[2].axhspan(probes.LEVEL_ATTITUDE - attitude_tolerance, probes.LEVEL_ATTITUDE + attitude_tolerance,
+                    color="green", alpha=0.15,
+                    label=f"level head ({probes.LEVEL_ATTITUDE:.0f} $\\pm$ {attitude_tolerance:.0f} deg)")
+    for ax in axes[1:]:
+        for j, change in enumerate(_target_changes(any_report)):
+            ax.axvline(change, color="grey", lw=0.7, ls="--", label="next target" if j == 0 else None)
+    axes[0].set_xlabel("x (m, forward)"); axes[0].set_ylabel("z (m, up)"); axes[0].set_aspect("equal", "datalim")
+    axes[0].set_title("(a) head path", fontsize=10)
     axes[1].set_xlabel("time (s)"); axes[1].set_ylabel("position error (m)")
-    axes[2].axhspan(probes.LEVEL_ATTITUDE - probes.ATTITUDE_TOLERANCE, probes.LEVEL_ATTITUDE + probes.ATTITUDE_TOLERANCE,
-                    color="green", alpha=0.15)
-    axes[2].set_xlabel("time (s)"); axes[2].set_ylabel("head attitude (deg)")
+    axes[1].set_title("(b) distance from the current target", fontsize=10)
+    axes[2].set_xlabel("time (s)"); axes[2].set_ylabel("head attitude (deg, 90 = level)")
+    axes[2].set_title("(c) head attitude", fontsize=10)
     for ax in axes:
-        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="best")
+    where = f"{any_report['domain']}/{any_report['task']}" if "task" in any_report else "track"
+    fig.suptitle(f"Tracking ({where}): the head visits {len(any_report['segments'])} targets in turn",
+                 fontsize=11)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    return fig
+
+
+def plot_track(reports: Dict[str, dict], path: str):
+    """Write :func:`track_figure` to ``path`` (PNG)."""
+    _save(track_figure(reports), path)

@@ -194,6 +194,14 @@ def hold_dorsal_length(dorsal_input: float, target: float, contraction: float, d
                          *control_range))
 
 
+def ventral_amplitudes(config: MovementConfig, physics: mjcf.Physics) -> np.ndarray:
+    """The contraction (m) each ventral tendon is ramped to: the configured amplitude,
+    clipped to that tendon's input range (so most get less than asked)."""
+    low, high = physics.model.actuator_ctrlrange.T
+    ventral = ventral_order(physics)
+    return np.clip(config.ventral_amplitude(), low[ventral], high[ventral])
+
+
 def schedule(config: MovementConfig, physics: mjcf.Physics):
     """``f(t) -> contraction targets`` for every tendon (dorsal: the held contraction).
 
@@ -202,8 +210,7 @@ def schedule(config: MovementConfig, physics: mjcf.Physics):
     """
     ventral = ventral_order(physics)
     dorsal = dorsal_index(physics)
-    low, high = physics.model.actuator_ctrlrange.T
-    amplitude = np.clip(config.ventral_amplitude(), low[ventral], high[ventral])
+    amplitude = ventral_amplitudes(config, physics)
     total = (len(ventral) - 1) * config.ramp_time
 
     def targets(t: float) -> np.ndarray:
@@ -237,6 +244,7 @@ class Movement:
     head_position: np.ndarray  # (n, 2) x, z (m)
     head_attitude: np.ndarray  # (n,) deg
     joint_points: np.ndarray  # (n, num_joints + 1, 2): base joint ... atlas joint, head tip
+    ventral_amplitudes: np.ndarray  # (num_ventral,) m, each ventral tendon's peak input
 
     @property
     def moving(self) -> np.ndarray:
@@ -256,6 +264,15 @@ class Movement:
         """Largest minus smallest head attitude (deg, unwrapped) while the ventral tendons move."""
         attitude = np.degrees(np.unwrap(np.radians(self.head_attitude[self.moving])))
         return float(np.ptp(attitude))
+
+    def amplitude_text(self) -> str:
+        """The ventral inputs' peaks as plotted, and what was asked when that was clipped."""
+        low, high = 1000 * self.ventral_amplitudes.min(), 1000 * self.ventral_amplitudes.max()
+        applied = f"{low:.1f} mm" if high - low < 0.05 else f"{low:.0f}-{high:.0f} mm"
+        asked = 1000 * self.config.ventral_amplitude()
+        if np.isclose(asked, 1000 * self.ventral_amplitudes).all():
+            return applied
+        return f"{applied} ({asked:.1f} mm asked, clipped to each tendon's range)"
 
     def summary(self) -> dict:
         return {"pattern": self.config.pattern, "head_travel_m": round(self.head_travel(), 4),
@@ -327,7 +344,8 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
         if k < steps:
             physics.step()
     time_, control, contraction, head, attitude, points = (np.array(c) for c in zip(*rows))
-    return Movement(config, names, time_, control, contraction, head, attitude, points)
+    return Movement(config, names, time_, control, contraction, head, attitude, points,
+                    ventral_amplitudes(config, physics))
 
 
 def match_lever_amplitude(config: MovementConfig, travel: float,
@@ -448,63 +466,95 @@ def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int
 
 # --------------------------------------------------------------------------- figures
 
-def plot_movement(movement: Movement, path: str | pathlib.Path, num_sticks: int = 12
-                  ) -> pathlib.Path:
-    """Figs. 4-5: (A) tendon inputs, (B) head attitude, (C) stick figures of the arm."""
+def movement_figure(movement: Movement, num_sticks: int = 12):
+    """Figs. 4-5 as a matplotlib Figure: (A) tendon inputs, (B) head attitude, (C) the arm."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig = plt.figure(figsize=(13, 5.2))
+    fig = plt.figure(figsize=(13, 5.6))
     grid = fig.add_gridspec(2, 2, width_ratios=[1.25, 1])
     ax_in, ax_att, ax_arm = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[1, 0]), \
         fig.add_subplot(grid[:, 1])
-    colors = plt.cm.viridis(np.linspace(0, 0.95, len(movement.tendon_names)))
-    for i, name in enumerate(movement.tendon_names):
-        style = dict(color="tab:red", lw=2.0) if "dorsal" in name else dict(color=colors[i])
-        ax_in.plot(movement.time, 1000 * movement.control[:, i], label=name, **style)
-    dorsal = movement.tendon_names.index("dorsal")
-    if movement.config.dorsal_hold == "length":
-        ax_in.plot(movement.time, 1000 * movement.contraction[:, dorsal], "--", color="tab:red",
-                   lw=1, label="dorsal, measured contraction")
-    ax_in.set_ylabel("tendon input (mm)")
-    low, high = ax_in.get_ylim()
-    ax_in.set_ylim(low, high + 0.9 * (high - low))  # headroom for the legend
-    ax_in.legend(fontsize=7, ncol=4, loc="upper left")
-    span = movement.config.ventral_span
-    tendons = "ventral tendons from the base" if span is None else f"ventral slips of {span} joints"
-    ax_in.set_title(f"(A) tendon inputs, {movement.config.pattern} pattern "
-                    f"({tendons}, dorsal {movement.config.dorsal_hold} held)", fontsize=10)
-    ax_att.plot(movement.time, movement.head_attitude, color="k")
-    ax_att.axvspan(0, SETTLE_TIME, color="0.9", label="settling to the start pose")
-    summary = movement.summary()
-    ax_att.set_title(f"(B) head attitude: range {summary['attitude_range_deg']:.1f} deg, "
-                     f"head travel {1000 * summary['head_travel_m']:.0f} mm", fontsize=10)
-    ax_att.set_ylabel("attitude (deg, 90 = level)")
-    ax_att.set_xlabel("time (s)")
-    ax_att.legend(fontsize=7, loc="best")
+    _plot_inputs(ax_in, movement)
+    _plot_attitude(ax_att, movement)
     for ax in (ax_in, ax_att):
         ax.grid(alpha=0.3)
         ax.set_xlim(movement.time[0], movement.time[-1])
+    _plot_arm(fig, ax_arm, movement, num_sticks)
+    fig.tight_layout()
+    return fig
+
+
+def _plot_inputs(ax, movement: Movement) -> None:
+    import matplotlib.pyplot as plt
+    colors = plt.cm.viridis(np.linspace(0, 0.95, len(movement.tendon_names)))
+    for i, name in enumerate(movement.tendon_names):
+        style = dict(color="tab:red", lw=2.0) if "dorsal" in name else dict(color=colors[i])
+        ax.plot(movement.time, 1000 * movement.control[:, i], label=name, **style)
+    dorsal = movement.tendon_names.index("dorsal")
+    if movement.config.dorsal_hold == "length":
+        ax.plot(movement.time, 1000 * movement.contraction[:, dorsal], "--", color="tab:red",
+                lw=1, label="dorsal, measured contraction")
+    ax.set_ylabel("tendon input (mm)")
+    low, high = ax.get_ylim()
+    ax.set_ylim(low, high + 0.9 * (high - low))  # headroom for the legend
+    ax.legend(fontsize=7, ncol=4, loc="upper left")
+    span = movement.config.ventral_span
+    tendons = "ventral tendons from the base" if span is None else f"ventral slips of {span} joints"
+    ax.set_title(f"(A) tendon inputs, {movement.config.pattern} pattern ({tendons}, dorsal "
+                 f"{movement.config.dorsal_hold} held)\nventral inputs up to "
+                 f"{movement.amplitude_text()}", fontsize=10)
+
+
+def _plot_attitude(ax, movement: Movement) -> None:
+    ax.plot(movement.time, movement.head_attitude, color="k")
+    ax.axvspan(0, SETTLE_TIME, color="0.9", label="settling to the start pose")
+    summary = movement.summary()
+    ax.set_title(f"(B) head attitude: range {summary['attitude_range_deg']:.1f} deg, "
+                 f"head travel {1000 * summary['head_travel_m']:.0f} mm", fontsize=10)
+    ax.set_ylabel("attitude (deg, 90 = level)")
+    ax.set_xlabel("time (s)")
+    ax.legend(fontsize=7, loc="lower right")
+
+
+def _plot_arm(fig, ax, movement: Movement, num_sticks: int) -> None:
+    """Stick figures coloured by time (with a colourbar), the head path and the base joint."""
+    import matplotlib.colors as mcolors
+    import matplotlib.pyplot as plt
     frames = np.flatnonzero(movement.moving)
     picks = frames[np.linspace(0, len(frames) - 1, num_sticks).astype(int)]
-    shades = plt.cm.plasma(np.linspace(0, 0.85, len(picks)))
-    for shade, frame in zip(shades, picks):
+    # plasma without its palest yellow, which vanishes on white
+    cmap = mcolors.ListedColormap(plt.cm.plasma(np.linspace(0, 0.85, 256)))
+    norm = mcolors.Normalize(movement.time[picks[0]], movement.time[picks[-1]])
+    for frame in picks:
+        shade = cmap(norm(movement.time[frame]))
         pts = movement.joint_points[frame]
-        ax_arm.plot(pts[:-1, 0], pts[:-1, 1], "-o", color=shade, ms=2, lw=1.2)
-        ax_arm.plot(pts[-2:, 0], pts[-2:, 1], "-", color=shade, lw=3.5)  # the head
-    ax_arm.plot(*movement.head_position[movement.moving].T, ":", color="k", lw=1,
-                label="head path")
-    ax_arm.plot(*movement.joint_points[0, 0], "ks", ms=7, label="C18-frame joint")
-    ax_arm.set_aspect("equal")
-    ax_arm.set_xlabel("x (m, forward)")
-    ax_arm.set_ylabel("z (m, up)")
-    ax_arm.grid(alpha=0.3)
-    ax_arm.legend(fontsize=8, loc="lower left")
-    ax_arm.set_title("(C) trajectory (early: purple, late: yellow); thick = head", fontsize=10)
-    fig.tight_layout()
+        ax.plot(pts[:-1, 0], pts[:-1, 1], "-o", color=shade, ms=2, lw=1.2)
+        ax.plot(pts[-2:, 0], pts[-2:, 1], "-", color=shade, lw=3.5)  # the head
+    ax.plot(*movement.head_position[movement.moving].T, ":", color="k", lw=1, label="head path")
+    ax.plot(*movement.joint_points[0, 0], "s", color="k", mec="w", ms=9, zorder=5,
+            label="C18-frame joint (base)")
+    ax.plot([], [], "-", color="0.4", lw=3.5, label="head")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m, forward)")
+    ax.set_ylabel("z (m, up)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=3, frameon=False)
+    colorbar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.8,
+                            pad=0.02)
+    colorbar.set_label("time (s)")
+    ax.set_title(f"(C) the arm every {np.diff(movement.time[picks]).mean():.1f} s "
+                 "while the ventral tendons move", fontsize=10)
+
+
+def plot_movement(movement: Movement, path: str | pathlib.Path, num_sticks: int = 12
+                  ) -> pathlib.Path:
+    """Write :func:`movement_figure` to ``path`` (PNG)."""
+    import matplotlib.pyplot as plt
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig = movement_figure(movement, num_sticks)
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
@@ -603,8 +653,8 @@ def main(argv=None) -> dict:
         print(f"{pattern:8s} head travel {1000 * s['head_travel_m']:6.1f} mm "
               f"(path {1000 * s['head_path_m']:.0f} mm), attitude "
               f"{s['attitude_start_deg']:.1f} -> {s['attitude_end_deg']:.1f} deg, "
-              f"range {s['attitude_range_deg']:.1f} deg, ventral amplitude "
-              f"{1000 * config.ventral_amplitude():.1f} mm")
+              f"range {s['attitude_range_deg']:.1f} deg, ventral inputs up to "
+              f"{movement.amplitude_text()}")
     if len(results) == 2:
         ratio = results["rolling"].attitude_range() / max(results["lever"].attitude_range(), 1e-9)
         print(f"attitude range rolling / lever: {ratio:.2f}")

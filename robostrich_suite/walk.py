@@ -47,7 +47,9 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
 
     Series: ``time``, ``trunk_height``, ``height_command``, ``head_height``,
     ``trunk_speed`` (forward), ``head_speed`` (3-D), ``head_vertical_speed``,
-    ``head_forward_distance`` (from the trunk centre), ``head_attitude``, ``trunk_pitch``.
+    ``head_forward_distance`` (from the trunk centre), ``head_attitude``, ``trunk_pitch``,
+    and the task's target: ``target_forward`` (P_d, ahead of the trunk centre) and
+    ``target_height`` (above the ground).
     """
     task_kwargs = dict(random=seed, time_limit=seconds)
     if gait is not None:
@@ -70,6 +72,7 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
         head = physics.head_position()
         head_velocity = physics.head_velocity()
         trunk_axis_x = physics.data.xmat[physics._robot()["trunk"]].reshape(3, 3)[:, 0]
+        target_forward, target_height = env.task.target_position  # trunk frame: ahead, up
         values = dict(
             time=t, trunk_height=physics.trunk_height(),
             height_command=env.task.trunk_height_command(physics), head_height=head[2],
@@ -78,7 +81,8 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
             head_vertical_speed=head_velocity[2],
             head_forward_distance=physics.to_trunk_frame(head)[0],
             head_attitude=physics.head_attitude(),
-            trunk_pitch=float(np.degrees(np.arcsin(np.clip(-trunk_axis_x[2], -1, 1)))))
+            trunk_pitch=float(np.degrees(np.arcsin(np.clip(-trunk_axis_x[2], -1, 1)))),
+            target_forward=target_forward, target_height=target_height)
         for key, value in values.items():
             series[key].append(float(value))
         if rec is not None:
@@ -95,30 +99,46 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
     return {key: np.array(value) for key, value in series.items()}
 
 
-def plot_walk(series: dict, path, title: str = "") -> None:
-    """PNG of trunk and head height, speed and attitude over time."""
+def walk_figure(series: dict, title: str = ""):
+    """Heights, speeds, head distance ahead of the trunk and angles over time, one panel each;
+    the trunk height has its own panel so its dip is not flattened by the head's scale."""
     t = series["time"]
-    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
+    fig, axes = plt.subplots(5, 1, figsize=(11, 12), sharex=True)
     axes[0].plot(t, series["head_height"], label="head height")
-    axes[0].plot(t, series["trunk_height"], label="trunk height")
-    axes[0].plot(t, series["height_command"], "--", label="trunk height command")
-    axes[0].set_ylabel("height above ground (m)")
-    axes[1].plot(t, series["trunk_speed"], label="trunk forward speed")
-    axes[1].plot(t, series["head_speed"], label="head speed (3-D)", alpha=0.8)
-    axes[1].plot(t, series["head_vertical_speed"], label="head vertical speed", alpha=0.8)
-    axes[1].set_ylabel("speed (m/s)")
-    axes[2].plot(t, series["head_forward_distance"], label="head ahead of trunk centre (P_d)")
-    axes[2].set_ylabel("distance (m)")
-    axes[3].plot(t, series["head_attitude"], label="head attitude (90 = level)")
-    axes[3].plot(t, series["trunk_pitch"], label="trunk pitch (nose down +)")
-    axes[3].set_ylabel("angle (deg)")
-    axes[3].set_xlabel("time (s)")
+    axes[0].plot(t, series["target_height"], "--", color="k", lw=1, label="target head height")
+    axes[0].set_ylabel("height above\nground (m)")
+    axes[0].set_title("(A) head height", fontsize=10)
+    axes[1].plot(t, series["trunk_height"], color="C1", label="trunk height")
+    axes[1].plot(t, series["height_command"], "--", color="C2", label="trunk height command")
+    axes[1].set_ylabel("height above\nground (m)")
+    axes[1].set_title("(B) trunk height and its command (own scale, to show the dip)", fontsize=10)
+    axes[2].plot(t, series["trunk_speed"], label="trunk forward speed")
+    axes[2].plot(t, series["head_speed"], label="head speed (3-D)", alpha=0.8)
+    axes[2].plot(t, series["head_vertical_speed"], label="head vertical speed", alpha=0.8)
+    axes[2].set_ylabel("speed (m/s)")
+    axes[2].set_title("(C) speeds", fontsize=10)
+    axes[3].plot(t, series["head_forward_distance"], label="head ahead of trunk centre")
+    axes[3].plot(t, series["target_forward"], "--", color="k", lw=1, label="target $P_d$")
+    axes[3].set_ylabel("distance (m)")
+    axes[3].set_title("(D) head distance ahead of the trunk centre and its target $P_d$",
+                      fontsize=10)
+    axes[4].plot(t, series["head_attitude"], label="head attitude (90 = level)")
+    axes[4].plot(t, series["trunk_pitch"], label="trunk pitch (nose down +)")
+    axes[4].set_ylabel("angle (deg)")
+    axes[4].set_xlabel("time (s)")
+    axes[4].set_title("(E) head attitude and trunk pitch", fontsize=10)
     for axis in axes:
         axis.grid(alpha=0.3)
-        axis.legend(loc="upper right", fontsize=8)
+        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     if title:
-        axes[0].set_title(title)
+        fig.suptitle(title)
     fig.tight_layout()
+    return fig
+
+
+def plot_walk(series: dict, path, title: str = "") -> None:
+    """Write :func:`walk_figure` to ``path`` (PNG)."""
+    fig = walk_figure(series, title)
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=100)
