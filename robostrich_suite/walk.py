@@ -111,7 +111,8 @@ def walk_figure(series: dict, title: str = ""):
     axes[1].plot(t, series["trunk_height"], color="C1", label="trunk height")
     axes[1].plot(t, series["height_command"], "--", color="C2", label="trunk height command")
     axes[1].set_ylabel("height above\nground (m)")
-    axes[1].set_title("(B) trunk height and its command (own scale, to show the dip)", fontsize=10)
+    axes[1].set_title("(B) trunk height and its command (own scale, so a commanded dip shows)",
+                      fontsize=10)
     axes[2].plot(t, series["trunk_speed"], label="trunk forward speed")
     axes[2].plot(t, series["head_speed"], label="head speed (3-D)", alpha=0.8)
     axes[2].plot(t, series["head_vertical_speed"], label="head vertical speed", alpha=0.8)
