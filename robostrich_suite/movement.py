@@ -522,6 +522,8 @@ def _plot_arm(fig, ax, movement: Movement, num_sticks: int) -> None:
     """Stick figures coloured by time (with a colourbar), the head path and the base joint."""
     import matplotlib.colors as mcolors
     import matplotlib.pyplot as plt
+    import matplotlib.transforms as mtransforms
+    from mpl_toolkits.axes_grid1 import make_axes_locatable
     frames = np.flatnonzero(movement.moving)
     picks = frames[np.linspace(0, len(frames) - 1, num_sticks).astype(int)]
     # plasma without its palest yellow, which vanishes on white
@@ -540,9 +542,15 @@ def _plot_arm(fig, ax, movement: Movement, num_sticks: int) -> None:
     ax.set_xlabel("x (m, forward)")
     ax.set_ylabel("z (m, up)")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=3, frameon=False)
-    colorbar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.8,
-                            pad=0.02)
+    # Below the x label (a fixed 36 pt under the axes, whatever their height): inside the
+    # axes the legend hid the base joint.
+    below = mtransforms.offset_copy(ax.transAxes, fig=fig, y=-36, units="points")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below,
+              ncol=3, frameon=False)
+    # A colourbar as tall as the (equal-aspect) axes.
+    colorbar_axes = make_axes_locatable(ax).append_axes("right", size="4%", pad=0.1)
+    colorbar_axes.set_label("<colorbar>")  # the label matplotlib gives the colourbars it places
+    colorbar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), cax=colorbar_axes)
     colorbar.set_label("time (s)")
     ax.set_title(f"(C) the arm every {np.diff(movement.time[picks]).mean():.1f} s "
                  "while the ventral tendons move", fontsize=10)
