@@ -65,7 +65,9 @@ def _mark_lessons(axes, boundaries, names, last_step) -> None:
         low, high = ax.get_ylim()
         ax.set_ylim(low, high + 0.08 * (high - low))  # headroom: names above the data
         top = mtransforms.blended_transform_factory(ax.transData, ax.transAxes)
+        shown_left, shown_right = ax.get_xlim()
         for name, left, right in zip(names, edges[:-1], edges[1:]):
+            left, right = max(left, shown_left), min(right, shown_right)  # centred on what shows
             ax.text((left + right) / 2, 0.98, name, transform=top, ha="center", va="top",
                     fontsize=8, color="0.35")
 
@@ -120,8 +122,8 @@ def learning_curves_figure(runs: Dict[str, List[dict]], evals: Dict[str, List[di
     else:
         axes[2].set_title("(c) held-out evaluation return", fontsize=10)
         axes[2].set_ylabel("episode return")
-    fig.suptitle("Learning curves: " + " vs ".join(runs) + " (lessons separated by dashed lines)",
-                 fontsize=11)
+    fig.suptitle("Learning curves: " + " vs ".join(runs) + " (the curriculum's lessons between "
+                 "dashed lines)", fontsize=11)
     fig.tight_layout()
     return fig
 

@@ -140,7 +140,10 @@ def test_learning_curves_have_titles_labelled_lines_and_a_whole_success_axis(pas
         assert "position tolerance (50 mm)" in _legend_labels(fig.axes[2])
         for ax in fig.axes:
             assert "lesson change" in _legend_labels(ax)
-            assert {"lesson1", "lesson2"} <= {t.get_text() for t in ax.texts}
+            names = {t.get_text(): t.get_position()[0] for t in ax.texts}
+            assert {"lesson1", "lesson2"} <= set(names)
+            low, high = ax.get_xlim()
+            assert all(low <= x <= high for x in names.values())  # none cut off at an edge
     finally:
         plt.close(fig)
 
