@@ -38,6 +38,7 @@ setup(
             "robostrich-export-xml = robostrich_suite.xml_export:cli",
             "robostrich-movement = robostrich_suite.movement:cli",
             "robostrich-workspace = robostrich_suite.workspace:cli",
+            "robostrich-layouts = robostrich_suite.layout_compare:cli",
         ],
     },
 )

@@ -36,10 +36,11 @@ def _load(path: str = str(DATA_PATH)) -> dict:
         return {key: data[key] for key in data.files}
 
 
-def level_head_poses() -> dict:
-    """All shipped level-head poses: ``head_position`` (n, 2), ``head_attitude`` (n,),
-    ``control`` (n, 9) and the ``fingerprint`` of the arm they were made with."""
-    return _load()
+def level_head_poses(path: str | pathlib.Path = DATA_PATH) -> dict:
+    """All shipped level-head poses (or those of a file :func:`generate` wrote):
+    ``head_position`` (n, 2), ``head_attitude`` (n,), ``control`` (n, tendons) and the
+    ``fingerprint`` of the arm they were made with."""
+    return _load(str(path))
 
 
 def distinct_indices(positions: np.ndarray, spacing: float = MIN_TARGET_SPACING) -> np.ndarray:
@@ -120,11 +121,20 @@ def generate(num_samples: int, seed: int = 0, path: pathlib.Path = DATA_PATH,
             if str(old["fingerprint"]) != fingerprint:
                 raise ValueError(f"{path} was made with another arm; regenerate without --append")
             new = {key: np.concatenate([old[key], value]) for key, value in new.items()}
+    return save_level_poses(path, new, fingerprint)
+
+
+def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str) -> int:
+    """Write ``poses`` (``head_position``, ``head_attitude``, ``control``) as a target file
+    of the arm with ``fingerprint``; returns how many.  Readers of ``path`` see the new file."""
+    path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(path, fingerprint=np.array(fingerprint), **new)
+    np.savez_compressed(path, fingerprint=np.array(fingerprint),
+                        **{key: np.asarray(poses[key]) for key in ("head_position", "head_attitude",
+                                                                  "control")})
     _load.cache_clear()
     _distinct_targets.cache_clear()
-    return len(new["head_position"])
+    return len(poses["head_position"])
 
 
 def main(argv=None) -> None:

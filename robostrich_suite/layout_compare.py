@@ -1,0 +1,409 @@
+"""``robostrich-layouts``: tendon layouts (and passive joint stiffnesses) side by side (issue 13).
+
+Every case is one routing on the same Table 1 links.  Per case:
+
+* **coverage**: the share of the kinematic blue-region cells (Fig. 6, head at
+  90 +- 5 deg; :mod:`robostrich_suite.coverage`) in which the actuated arm holds its
+  head level, from two samplers run alike for every case: random held inputs with
+  the dorsal input tuned for a level head (``targets.generate``'s way) and one sought
+  pose per blue sample (:mod:`robostrich_suite.pose_seek`);
+* **distinct level targets**: the held level poses at least 1 cm apart (the
+  tasks' target spacing); they are written as the case's own target file;
+* **rolling / lever**: the movement tests' attitude ranges at equal head travel and
+  their ratio (:mod:`robostrich_suite.movement`; the layout's ventral tendons ramped
+  caudal to cranial, its most cranial dorsal tendon's input held);
+* **lookup**: held-out success of the no-learning baseline (nearest stored level
+  pose, hold its inputs) on the case's own targets; with ``--train``, the held-out
+  success of a short curriculum run of ``robostrich-train``'s learner too.
+
+Writes ``layouts.md``, ``layouts.csv``, ``layouts.png`` (blue region with the held
+level poses, and the routing on a stick figure, per case) and ``targets/CASE.npz``.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import pathlib
+import time
+
+import numpy as np
+
+from robostrich_suite import arm as arm_lib
+from robostrich_suite import coverage as coverage_lib
+from robostrich_suite import layouts as layouts_lib
+from robostrich_suite import movement, pose_seek, targets, workspace
+
+PROG = "robostrich-layouts"
+DEFAULT_KINEMATIC_SAMPLES = 100_000  # the issue's blue region: workspace.kinematic_samples(100000)
+DEFAULT_RANDOM_SAMPLES = 300
+DEFAULT_TRAIN_STEPS = 4000
+
+
+@dataclasses.dataclass(frozen=True)
+class Case:
+    """One routing on one arm spec, under a label for the table and the figure."""
+    label: str
+    layout_name: str
+    spec: arm_lib.ArmSpec
+    layout: arm_lib.TendonLayout
+    source: str  # "built-in" or the layout file
+
+
+@dataclasses.dataclass(frozen=True)
+class Options:
+    random_samples: int = DEFAULT_RANDOM_SAMPLES
+    seek_time: float = pose_seek.SEEK_TIME
+    seed: int = 0
+    movement: bool = True
+    lookup: bool = True
+    train_steps: int = 0  # 0: no curriculum run
+    out: pathlib.Path = pathlib.Path("out/layouts")
+
+    def units(self, region: coverage_lib.BlueRegion) -> int:
+        """Progress units of one case: one per sampled pose, one per later stage."""
+        return (self.random_samples + len(region.head_position) + self.movement + self.lookup
+                + (self.train_steps > 0))
+
+
+# --------------------------------------------------------------------------- measures
+
+@dataclasses.dataclass(frozen=True)
+class _LayoutMovement(movement.MovementConfig):
+    """A movement test on a given layout (MovementConfig picks its own from ``ventral_span``)."""
+    tendon_layout: arm_lib.TendonLayout | None = None
+
+    def layout(self, spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
+        return self.tendon_layout
+
+
+def movement_layout(layout: arm_lib.TendonLayout, spec: arm_lib.ArmSpec):
+    """The layout renamed the way the movement tests find their tendons (the most cranial
+    dorsal tendon ``dorsal``, the ventral ones ``ventral_i`` caudal to cranial, other
+    dorsal ones ``extra_i``), or None without a dorsal and two ventral tendons."""
+    rank = {name: i for i, name in enumerate(reversed(spec.joint_names))}  # caudal = 0
+    dorsal = sorted((t for t in layout.tendons if t.side == "dorsal"), key=lambda t: rank[t.insertion])
+    ventral = sorted((t for t in layout.tendons if t.side == "ventral"), key=lambda t: rank[t.insertion])
+    if not dorsal or len(ventral) < 2:
+        return None
+    renamed = [dataclasses.replace(dorsal[-1], name="dorsal")]
+    renamed += [dataclasses.replace(t, name=f"extra_{i}") for i, t in enumerate(dorsal[:-1])]
+    renamed += [dataclasses.replace(t, name=f"ventral_{i}") for i, t in enumerate(ventral)]
+    return arm_lib.TendonLayout(tuple(renamed))
+
+
+def movement_ratio(case: Case) -> dict:
+    """Rolling and lever attitude ranges at equal head travel (the movement tests' defaults)."""
+    layout = movement_layout(case.layout, case.spec)
+    if layout is None:
+        return {"rolling_range_deg": None, "lever_range_deg": None, "rolling_lever_ratio": None,
+                "head_travel_m": None}
+    rolling = movement.run(_LayoutMovement(tendon_layout=layout), case.spec)
+    lever = _LayoutMovement(pattern="lever", tendon_layout=layout)
+    amplitude = movement.match_lever_amplitude(lever, rolling.head_travel(), case.spec)
+    lever = movement.run(dataclasses.replace(lever, lever_amplitude=amplitude), case.spec)
+    ratio = rolling.attitude_range() / max(lever.attitude_range(), 1e-9)
+    return {"rolling_range_deg": rolling.attitude_range(), "lever_range_deg": lever.attitude_range(),
+            "rolling_lever_ratio": ratio, "head_travel_m": rolling.head_travel()}
+
+
+def heldout_success(case: Case, heldout: np.ndarray, make_actor, seed: int = 10_000) -> dict:
+    """``agents.evaluation``'s held-out summary on the case's arm: one lesson-2 episode
+    from the fixed start per target.  ``make_actor(flattener)`` gives the policy."""
+    import robostrich_suite
+    from agents import evaluation
+    from agents.replay import ObservationFlattener
+    env = robostrich_suite.load("robostrich", evaluation.default_heldout_task("robostrich", "lesson3"),
+                                task_kwargs=dict(random=seed, arm_spec=case.spec,
+                                                 tendon_layout=case.layout, target_pool=heldout[:1]))
+    flattener = ObservationFlattener(env.observation_spec())
+    actor = make_actor(flattener)
+    episodes = []
+    for target in heldout:
+        env.task.target_pool = np.asarray(target, np.float64)[None]
+        episodes.append(evaluation._episode_summary(evaluation.rollout(env, actor, flattener)))
+    return evaluation.summarize(episodes)
+
+
+def lookup_success(case: Case, target_path: pathlib.Path) -> dict:
+    """The lookup baseline on the case's own targets (its table keeps no held-out pose)."""
+    from agents.lookup import LookupPolicy, lookup_table
+    heldout = targets.heldout_targets(target_path)
+    table = lookup_table(targets.level_head_poses(target_path), heldout)
+    return heldout_success(case, heldout, lambda flattener: LookupPolicy(flattener, table))
+
+
+def curriculum_success(case: Case, target_path: pathlib.Path, steps: int, seed: int,
+                       run_dir: pathlib.Path) -> dict:
+    """A short curriculum (lessons 1-3 in equal parts, ``robostrich-train``'s learner and
+    defaults) on the case's own training targets, then its held-out success."""
+    from agents.curriculum import CurriculumRun, make_environment, parse_plan
+    from agents.sac.builder import SACBuilder
+    from agents.sac.config import SACConfig
+    arm_kwargs = dict(arm_spec=case.spec, tendon_layout=case.layout,
+                      target_pool=targets.training_targets(target_path))
+
+    def env_factory(domain, task, env_seed, **task_kwargs):  # the arm stays out of the fingerprint
+        return make_environment(domain, task, env_seed, **arm_kwargs, **task_kwargs)
+
+    per_lesson = max(steps // 3, 1)
+    plan = parse_plan(",".join(f"lesson{i}:{per_lesson}" for i in (1, 2, 3)))
+    run = CurriculumRun(plan, SACConfig(), seed, str(run_dir), checkpoint_every=10 ** 9,
+                        env_factory=env_factory, name=case.label)
+    run.run()
+    actor = SACBuilder.make_eval_actor(run.loop)
+    return heldout_success(case, targets.heldout_targets(target_path), lambda flattener: actor)
+
+
+def measure(case: Case, region: coverage_lib.BlueRegion, options: Options, progress=None) -> dict:
+    """Every measure of one case; ``progress(n)`` advances a bar by n units."""
+    progress = progress or (lambda n: None)
+    random = workspace.actuated_samples(options.random_samples, options.seed, pose_seek.HOLD_TIME,
+                                        seek_level_time=targets.SEEK_LEVEL_TIME, spec=case.spec,
+                                        layout=case.layout)
+    progress(options.random_samples)
+    sought = pose_seek.seek_samples(region.head_position, region.joint_angles, case.spec,
+                                    case.layout, options.seek_time, progress=progress)
+    samples = workspace.ActuatedSamples.concatenate([random, sought])
+    level = samples.level()
+    held = samples.head_position[level]
+    covered = region.covered(held)
+    target_path = options.out / "targets" / f"{case.label}.npz"
+    targets.save_level_poses(target_path, dict(head_position=held,
+                                               head_attitude=samples.head_attitude[level],
+                                               control=samples.control[level]),
+                             workspace.model_fingerprint(case.spec, case.layout))
+    row = {"layout": case.label, "source": case.source,
+           "joint_stiffness": case.spec.joint_stiffness, "tendons": len(case.layout),
+           "blue_cells": region.num_cells, "covered_cells": int(covered.sum()),
+           "coverage": float(covered.mean()) if region.num_cells else 0.0,
+           "level_poses": int(level.sum()), "level_poses_sought": int(sought.level().sum()),
+           "distinct_targets": len(targets.distinct_indices(held)) if len(held) else 0,
+           "target_file": str(target_path)}
+    if options.movement:
+        row.update(movement_ratio(case))
+        progress(1)
+    heldout_count = len(targets.heldout_targets(target_path)) if len(held) else 0
+    row["heldout_targets"] = heldout_count
+    if options.lookup:
+        row["lookup_success"] = (lookup_success(case, target_path)["success_rate"]
+                                 if heldout_count else None)
+        progress(1)
+    if options.train_steps > 0:
+        row["curriculum_success"] = (
+            curriculum_success(case, target_path, options.train_steps, options.seed,
+                               options.out / "train" / case.label)["success_rate"]
+            if heldout_count and len(targets.training_targets(target_path)) else None)
+        progress(1)
+    return {"row": row, "held": held, "covered": covered}
+
+
+def _measure_job(args):
+    case, region, options, queue = args
+    return measure(case, region, options, progress=queue.put)
+
+
+def measure_all(cases, region, options: Options, workers: int = 1, show_progress: bool = True):
+    """``measure`` every case (over ``workers`` processes), with one progress bar."""
+    from tqdm import tqdm
+    bar = tqdm(total=len(cases) * options.units(region), desc="layouts", unit="step",
+               disable=not show_progress, mininterval=1.0)
+    try:
+        if workers <= 1 or len(cases) == 1:
+            results = []
+            for case in cases:
+                bar.set_postfix_str(case.label)
+                results.append(measure(case, region, options, progress=bar.update))
+            return results
+        import multiprocessing
+        import queue as queue_lib
+        from concurrent.futures import ProcessPoolExecutor
+        with multiprocessing.Manager() as manager, ProcessPoolExecutor(min(workers, len(cases))) as pool:
+            queue = manager.Queue()
+            futures = [pool.submit(_measure_job, (case, region, options, queue)) for case in cases]
+            while not all(f.done() for f in futures):
+                try:
+                    bar.update(queue.get(timeout=0.5))
+                except queue_lib.Empty:
+                    pass
+            while not queue.empty():
+                bar.update(queue.get())
+            return [f.result() for f in futures]
+    finally:
+        bar.close()
+
+
+# --------------------------------------------------------------------------- cases, tables
+
+def make_cases(names, files, stiffnesses) -> list[Case]:
+    """Built-ins ``names`` and layout ``files`` on Table 1's arm at each passive stiffness
+    (None: the arm's own); a label per case, unique."""
+    default = arm_lib.ArmSpec.from_table1()
+    stiffnesses = list(stiffnesses) or [default.joint_stiffness]
+    cases = []
+    for stiffness in stiffnesses:
+        spec = arm_lib.ArmSpec.from_table1(joint_stiffness=float(stiffness))
+        spec.validate()
+        suffix = "" if len(stiffnesses) == 1 else f"@k{float(stiffness):g}"
+        layouts = [(name, layouts_lib.build(name, spec), "built-in") for name in names]
+        for path in files:
+            name, layout = layouts_lib.read_file(path, spec)
+            layouts.append((name, layout, str(path)))
+        for name, layout, source in layouts:
+            if len(layout) > layouts_lib.MAX_TENDONS:
+                raise ValueError(f"layout {name!r} ({source}) has {len(layout)} tendons; the "
+                                 f"comparison is at the paper's {layouts_lib.MAX_TENDONS} servos at most")
+            cases.append(Case(f"{name}{suffix}", name, spec, layout, source))
+    labels = [c.label for c in cases]
+    duplicates = sorted({x for x in labels if labels.count(x) > 1})
+    if duplicates:
+        raise ValueError(f"two layouts are called {duplicates}; give each file its own 'name'")
+    return cases
+
+
+COLUMNS = (  # (row key, table heading, format)
+    ("layout", "layout", "{}"),
+    ("joint_stiffness", "stiffness (N m/rad)", "{:g}"),
+    ("tendons", "tendons", "{}"),
+    ("covered_cells", "blue cells held", "{}"),
+    ("blue_cells", "blue cells", "{}"),
+    ("coverage", "coverage", "{:.0%}"),
+    ("level_poses", "level poses held", "{}"),
+    ("distinct_targets", "distinct level targets", "{}"),
+    ("rolling_range_deg", "rolling range (deg)", "{:.1f}"),
+    ("lever_range_deg", "lever range (deg)", "{:.1f}"),
+    ("rolling_lever_ratio", "rolling / lever", "{:.2f}"),
+    ("heldout_targets", "held-out targets", "{}"),
+    ("lookup_success", "lookup held-out success", "{:.0%}"),
+    ("curriculum_success", "curriculum held-out success", "{:.0%}"),
+)
+
+
+def _columns(rows):
+    return [c for c in COLUMNS if any(c[0] in row for row in rows)]
+
+
+def markdown_table(rows) -> str:
+    columns = _columns(rows)
+    lines = ["| " + " | ".join(c[1] for c in columns) + " |",
+             "|" + "|".join("---" for _ in columns) + "|"]
+    for row in rows:
+        cells = ["n/a" if row.get(key) is None else fmt.format(row[key]) for key, _, fmt in columns]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def write_csv(path: pathlib.Path, rows) -> None:
+    keys = list(dict.fromkeys(key for row in rows for key in row))
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=keys)
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+# --------------------------------------------------------------------------- command line
+
+def _positive(kind):
+    def parse(text):
+        value = kind(text)
+        if not value > 0:
+            raise argparse.ArgumentTypeError(f"must be positive, got {text}")
+        return value
+    return parse
+
+
+def _non_negative_int(text):
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be 0 or more, got {text}")
+    return value
+
+
+def main(argv=None) -> dict:
+    """Command line: measure the cases, write the table, the CSV, the figure and the targets."""
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description="Compare tendon layouts (and passive joint stiffnesses) of the Robostrich "
+                    "arm on the same Table 1 links: share of the blue region of Fig. 6 held "
+                    "level (coverage), distinct level targets, rolling/lever attitude ranges, "
+                    "held-out success of the lookup baseline (and, with --train, of a short "
+                    "curriculum run). Writes layouts.md, layouts.csv, layouts.png and "
+                    "targets/LAYOUT.npz under --out.",
+        epilog="built-in layouts: " + "; ".join(f"{name}: {b.description}"
+                                                 for name, b in layouts_lib.BUILT_IN.items()))
+    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/layouts"),
+                        help="output directory (default: %(default)s)")
+    parser.add_argument("--layouts", nargs="*", default=list(layouts_lib.BUILT_IN),
+                        choices=list(layouts_lib.BUILT_IN), metavar="NAME",
+                        help="built-in layouts to compare (default: all of them)")
+    parser.add_argument("--layout-file", nargs="+", default=[], type=pathlib.Path, metavar="FILE",
+                        help="also compare layouts from JSON/TOML files (see "
+                             "robostrich_suite/layouts.py for the format)")
+    parser.add_argument("--stiffness", nargs="+", type=_positive(float), default=[],
+                        metavar="N_M_PER_RAD",
+                        help="passive joint stiffnesses to sweep, every layout at each "
+                             "(default: the arm's own)")
+    parser.add_argument("--kinematic-samples", type=_positive(int), default=DEFAULT_KINEMATIC_SAMPLES,
+                        help="uniform kinematic samples that make the blue region (default: %(default)s)")
+    parser.add_argument("--random-samples", type=_non_negative_int, default=DEFAULT_RANDOM_SAMPLES,
+                        help="random held inputs per case, dorsal tuned for a level head "
+                             "(default: %(default)s)")
+    parser.add_argument("--seek-time", type=_positive(float), default=pose_seek.SEEK_TIME,
+                        help="seconds of input adjustment per sought blue-region pose "
+                             "(default: %(default)s)")
+    parser.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    parser.add_argument("--no-movement", action="store_true", help="skip the rolling/lever tests")
+    parser.add_argument("--no-lookup", action="store_true", help="skip the lookup baseline")
+    parser.add_argument("--train", action="store_true",
+                        help="also train a short curriculum per case on its own targets and "
+                             "report its held-out success")
+    parser.add_argument("--train-steps", type=_positive(int), default=DEFAULT_TRAIN_STEPS,
+                        help="control steps of that run, split over lessons 1-3 (default: %(default)s)")
+    parser.add_argument("--workers", type=_positive(int), default=1,
+                        help="processes, one case each (default: %(default)s)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    args = parser.parse_args(argv)
+    if not args.layouts and not args.layout_file:
+        parser.error("nothing to compare: give --layouts and/or --layout-file")
+
+    start = time.perf_counter()
+    cases = make_cases(args.layouts, args.layout_file, args.stiffness)
+    options = Options(args.random_samples, args.seek_time, args.seed, not args.no_movement,
+                      not args.no_lookup, args.train_steps if args.train else 0, args.out)
+    region = coverage_lib.BlueRegion.from_samples(
+        workspace.kinematic_samples(args.kinematic_samples, args.seed, cases[0].spec))
+    if region.num_cells == 0:
+        raise ValueError(f"no level head among {args.kinematic_samples} kinematic samples; "
+                         "raise --kinematic-samples")
+    results = measure_all(cases, region, options, args.workers, not args.no_progress)
+    rows = [r["row"] for r in results]
+    args.out.mkdir(parents=True, exist_ok=True)
+    table = markdown_table(rows)
+    (args.out / "layouts.md").write_text(
+        f"Blue region: {len(region.head_position)} level heads among {args.kinematic_samples} "
+        f"kinematic samples, {region.num_cells} cells of {coverage_lib.CELL_SIZE * 100:g} cm; "
+        f"{args.random_samples} random + {len(region.head_position)} sought poses per layout.\n\n"
+        + table)
+    write_csv(args.out / "layouts.csv", rows)
+    from robostrich_suite import layout_figure
+    figure = layout_figure.plot(cases, region, results, args.out / "layouts.png")
+    print(table, end="")
+    best = max(rows, key=lambda row: row["coverage"])
+    print(f"largest share of the blue region held: {best['layout']} ({best['coverage']:.0%})")
+    for name in ("layouts.md", "layouts.csv"):
+        print(f"wrote {args.out / name}")
+    print(f"wrote {figure}")
+    print(f"wrote {args.out / 'targets'}/ (one target file per layout)")
+    print(f"done in {time.perf_counter() - start:.1f} s")
+    return {"rows": rows, "figure": figure}
+
+
+def cli(argv=None) -> int:
+    """Console script `robostrich-layouts`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
+    from robostrich_suite import cli as cli_lib
+    return cli_lib.run(main, PROG, argv)
+
+
+if __name__ == "__main__":
+    import sys
+    sys.exit(cli())

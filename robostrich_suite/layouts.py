@@ -1,0 +1,236 @@
+"""Named tendon layouts, and layouts read from a small declarative file (issue 13).
+
+The paper tested one routing and left "the comparison of various tendon
+configurations" open; ``robostrich-layouts`` (:mod:`robostrich_suite.layout_compare`)
+compares the ones here.  Every built-in uses the Table 1 links, at most
+:data:`MAX_TENDONS` tendons and the generator's servos (ranges from the joint
+limits, the same force limit), so only the routing differs.
+
+A user tries another routing without Python in JSON or TOML; each tendon has a
+``name``, a ``side`` (dorsal or ventral) and either ``links`` (the holes it runs
+through, caudal to cranial; ``on_base`` false ties it at the first one instead of
+an anchor on the base) or ``from``/``to`` (every link between, as
+``TendonSpec.spanning``)::
+
+    name = "two_dorsal"
+    [[tendons]]
+    name = "dorsal"
+    side = "dorsal"
+    from = "c18"
+    to = "atlas"
+    [[tendons]]
+    name = "ventral_skip"
+    side = "ventral"
+    links = ["c18", "c12", "c6", "c3"]
+
+A malformed file raises :class:`LayoutFileError` (a ``ValueError``) naming the
+file, the tendon and what is wrong; a well-formed file describing a bad layout
+gets ``TendonLayout.validate``'s message, prefixed with the file.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import pathlib
+from typing import Callable
+
+from robostrich_suite import arm as arm_lib
+
+MAX_TENDONS = 9  # the paper's 9 servos: the comparison is at the same actuation budget
+DATA_DIR = pathlib.Path(__file__).parent / "data"
+
+# Antagonist pairs: the neck cut into four stretches, each with a dorsal and a ventral
+# slip between the same two links, plus the paper's dorsal tendon to the head.  The
+# cuts are where the comparison found the largest share of the blue region held
+# (docs/layouts.md): the passive neck is an inverted pendulum, and a stretch pulled
+# from both sides holds its bend whichever way gravity turns it.
+ANTAGONIST_CUTS = ("c18", "c13", "c9", "c5", "atlas")
+
+
+class LayoutFileError(ValueError):
+    """A layout file that cannot be read as a layout; the message names file and item."""
+
+
+def paper(spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
+    """The paper's routing (the tasks' default): a dorsal tendon to the head and 8
+    ventral tendons from the base, inserting at every second vertebra C16 ... C2."""
+    return arm_lib.TendonLayout.robostrich(spec)
+
+
+def ventral_slips(spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
+    """The paper's insertions, each ventral tendon tied 4 joints caudal of it (the
+    ostrich's overlapping longus colli slips; the movement tests' default)."""
+    return arm_lib.TendonLayout.ventral_slips(spec)
+
+
+def second_dorsal(spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
+    """A second dorsal tendon from the base to mid-neck (C9) that holds the caudal neck
+    up against gravity; the most caudal ventral tendon (C16) gives way to it."""
+    dorsal = arm_lib.TendonSpec.spanning("dorsal", "dorsal", spec.head_name, spec)
+    mid = arm_lib.TendonSpec.spanning("dorsal_c9", "dorsal", "c9", spec)
+    ventral = [arm_lib.TendonSpec.spanning(f"ventral_{link}", "ventral", link, spec)
+               for link in arm_lib.TendonLayout.ROBOSTRICH_VENTRAL_INSERTIONS[1:]]
+    return arm_lib.TendonLayout((dorsal, mid, *ventral))
+
+
+def cranial_every(spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
+    """Ventral tendons from the base inserting on every vertebra of the cranial half
+    (C9 ... C2), where Table 1 allows the largest bends."""
+    dorsal = arm_lib.TendonSpec.spanning("dorsal", "dorsal", spec.head_name, spec)
+    ventral = [arm_lib.TendonSpec.spanning(f"ventral_c{n}", "ventral", f"c{n}", spec)
+               for n in range(9, 1, -1)]
+    return arm_lib.TendonLayout((dorsal, *ventral))
+
+
+def antagonist_pairs(spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
+    """The paper's dorsal tendon plus a dorsal and a ventral slip on each of four
+    stretches of the neck (cut at :data:`ANTAGONIST_CUTS`)."""
+    tendons = [arm_lib.TendonSpec.spanning("dorsal", "dorsal", spec.head_name, spec)]
+    for origin, insertion in zip(ANTAGONIST_CUTS[:-1], ANTAGONIST_CUTS[1:]):
+        for side in arm_lib.SIDES:
+            tendons.append(arm_lib.TendonSpec.spanning(f"{side}_{origin}_{insertion}", side,
+                                                       insertion, spec, origin=origin))
+    return arm_lib.TendonLayout(tuple(tendons))
+
+
+@dataclasses.dataclass(frozen=True)
+class BuiltIn:
+    factory: Callable[[arm_lib.ArmSpec], arm_lib.TendonLayout]
+
+    @property
+    def description(self) -> str:
+        return " ".join(self.factory.__doc__.split())
+
+
+BUILT_IN = {f.__name__: BuiltIn(f) for f in (paper, ventral_slips, second_dorsal, cranial_every,
+                                             antagonist_pairs)}
+DEFAULT = "paper"  # the tasks' layout
+
+
+def build(name: str, spec: arm_lib.ArmSpec | None = None) -> arm_lib.TendonLayout:
+    """The built-in layout ``name`` on ``spec`` (default: Table 1's arm)."""
+    if name not in BUILT_IN:
+        raise ValueError(f"unknown layout {name!r}; built-in layouts are {list(BUILT_IN)}")
+    return BUILT_IN[name].factory(spec or arm_lib.ArmSpec.from_table1())
+
+
+def target_file(name: str) -> pathlib.Path:
+    """The shipped level-pose target file of a built-in layout (``targets.generate``'s
+    format): pass ``targets.training_targets(target_file(name))`` as ``target_pool``."""
+    if name == DEFAULT:
+        from robostrich_suite import targets
+        return targets.DATA_PATH
+    path = DATA_DIR / f"level_head_poses_{name}.npz"
+    if not path.exists():
+        shipped = [DEFAULT] + sorted(p.stem.removeprefix("level_head_poses_")
+                                     for p in DATA_DIR.glob("level_head_poses_*.npz"))
+        raise FileNotFoundError(f"no target file ships for layout {name!r}; layouts with one: "
+                                f"{shipped} (make one with robostrich-layouts --write-targets)")
+    return path
+
+
+def task_kwargs(name: str) -> dict:
+    """``task_kwargs`` for the reaching tasks on built-in layout ``name`` with its own
+    shipped targets, e.g. ``robostrich_suite.load("robostrich", "lesson2",
+    task_kwargs=layouts.task_kwargs("antagonist_pairs"))``."""
+    from robostrich_suite import targets
+    return dict(tendon_layout=build(name), target_pool=targets.training_targets(target_file(name)))
+
+
+# --------------------------------------------------------------------------- files
+
+TENDON_KEYS = ("name", "side", "links", "on_base", "from", "to")
+FILE_KEYS = ("name", "tendons")
+
+
+def to_dict(layout: arm_lib.TendonLayout, name: str | None = None) -> dict:
+    """The declarative form of ``layout`` (explicit ``links``): ``json.dumps`` it to
+    start a file from a built-in."""
+    tendons = [{"name": t.name, "side": t.side, "links": list(t.links), "on_base": t.on_base}
+               for t in layout.tendons]
+    return {"name": name, "tendons": tendons} if name else {"tendons": tendons}
+
+
+def from_dict(data, spec: arm_lib.ArmSpec | None = None, source: str = "layout"
+              ) -> arm_lib.TendonLayout:
+    """A validated layout from its declarative form; errors name ``source`` and the item."""
+    spec = spec or arm_lib.ArmSpec.from_table1()
+
+    def fail(message):
+        raise LayoutFileError(f"{source}: {message}")
+
+    if not isinstance(data, dict):
+        fail(f"expected a table/object with 'tendons', got {type(data).__name__}")
+    unknown = sorted(set(data) - set(FILE_KEYS))
+    if unknown:
+        fail(f"unknown key(s) {unknown}; a layout file has {list(FILE_KEYS)}")
+    if "name" in data and not isinstance(data["name"], str):
+        fail(f"'name' must be a string, got {data['name']!r}")
+    entries = data.get("tendons")
+    if not isinstance(entries, list) or not entries:
+        fail("'tendons' must be a non-empty list of tendons")
+    tendons = []
+    for i, entry in enumerate(entries, 1):
+        label = f"tendon {i}"
+        if not isinstance(entry, dict):
+            fail(f"{label}: expected a table/object, got {type(entry).__name__}")
+        if isinstance(entry.get("name"), str):
+            label = f"tendon {i} ({entry['name']!r})"
+        unknown = sorted(set(entry) - set(TENDON_KEYS))
+        if unknown:
+            fail(f"{label}: unknown key(s) {unknown}; a tendon has {list(TENDON_KEYS)}")
+        for key in ("name", "side"):
+            if not isinstance(entry.get(key), str):
+                fail(f"{label}: '{key}' must be a string, got {entry.get(key)!r}")
+        has_links, has_span = "links" in entry, ("from" in entry or "to" in entry)
+        if has_links == has_span:
+            fail(f"{label}: give either 'links' (caudal to cranial) or 'from' and 'to'")
+        if has_links:
+            links = entry["links"]
+            if not isinstance(links, list) or not all(isinstance(x, str) for x in links):
+                fail(f"{label}: 'links' must be a list of link names, got {links!r}")
+            on_base = entry.get("on_base", True)
+            if not isinstance(on_base, bool):
+                fail(f"{label}: 'on_base' must be true or false, got {on_base!r}")
+            tendons.append(arm_lib.TendonSpec(entry["name"], entry["side"], tuple(links), on_base))
+        else:
+            if "on_base" in entry:
+                fail(f"{label}: 'on_base' goes with 'links'; with 'from' the base link means "
+                     "anchored on the base")
+            for key in ("from", "to"):
+                if not isinstance(entry.get(key), str):
+                    fail(f"{label}: '{key}' must be a link name, got {entry.get(key)!r}")
+            try:
+                tendons.append(arm_lib.TendonSpec.spanning(entry["name"], entry["side"], entry["to"],
+                                                           spec, origin=entry["from"]))
+            except ValueError as error:
+                fail(str(error))
+    layout = arm_lib.TendonLayout(tuple(tendons))
+    try:
+        layout.validate(spec)
+    except ValueError as error:
+        fail(str(error))
+    return layout
+
+
+def read_file(path, spec: arm_lib.ArmSpec | None = None) -> tuple[str, arm_lib.TendonLayout]:
+    """``(name, layout)`` from a ``.json`` or ``.toml`` file; the name defaults to the
+    file's stem."""
+    path = pathlib.Path(path)
+    text = path.read_text(encoding="utf-8")  # a missing file is an OSError naming it
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".json":
+            data = json.loads(text)
+        elif suffix == ".toml":
+            import tomllib
+            data = tomllib.loads(text)
+        else:
+            raise LayoutFileError(f"{path}: unknown layout file type {path.suffix!r}; "
+                                  "use .json or .toml")
+    except (json.JSONDecodeError, ValueError) as error:
+        if isinstance(error, LayoutFileError):
+            raise
+        raise LayoutFileError(f"{path}: not valid {suffix[1:].upper()}: {error}") from None
+    layout = from_dict(data, spec, source=str(path))
+    return data.get("name") or path.stem, layout
