@@ -38,6 +38,7 @@ PROG = "robostrich-layouts"
 DEFAULT_KINEMATIC_SAMPLES = 100_000  # the issue's blue region: workspace.kinematic_samples(100000)
 DEFAULT_RANDOM_SAMPLES = 300
 DEFAULT_TRAIN_STEPS = 4000
+RANDOM_CHUNK = 10  # random samples per progress update
 
 
 @dataclasses.dataclass(frozen=True)
@@ -158,13 +159,16 @@ def curriculum_success(case: Case, target_path: pathlib.Path, steps: int, seed: 
 def measure(case: Case, region: coverage_lib.BlueRegion, options: Options, progress=None) -> dict:
     """Every measure of one case; ``progress(n)`` advances a bar by n units."""
     progress = progress or (lambda n: None)
-    random = workspace.actuated_samples(options.random_samples, options.seed, pose_seek.HOLD_TIME,
-                                        seek_level_time=targets.SEEK_LEVEL_TIME, spec=case.spec,
-                                        layout=case.layout)
-    progress(options.random_samples)
+    random = []
+    for start in range(0, options.random_samples, RANDOM_CHUNK):  # chunks: the bar moves
+        size = min(RANDOM_CHUNK, options.random_samples - start)
+        random.append(workspace.actuated_samples(size, [options.seed, start], pose_seek.HOLD_TIME,
+                                                 seek_level_time=targets.SEEK_LEVEL_TIME,
+                                                 spec=case.spec, layout=case.layout))
+        progress(size)
     sought = pose_seek.seek_samples(region.head_position, region.joint_angles, case.spec,
                                     case.layout, options.seek_time, progress=progress)
-    samples = workspace.ActuatedSamples.concatenate([random, sought])
+    samples = workspace.ActuatedSamples.concatenate([*random, sought])
     level = samples.level()
     held = samples.head_position[level]
     covered = region.covered(held)

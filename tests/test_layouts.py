@@ -144,6 +144,21 @@ def test_movement_tests_find_any_layouts_dorsal_and_ventral_tendons():
     assert layout_compare.movement_layout(only_dorsal, spec) is None
 
 
+def test_the_better_layout_ships_with_its_own_targets_loadable_through_task_kwargs():
+    import robostrich_suite
+    from robostrich_suite import targets
+    path = layouts.target_file("antagonist_pairs")
+    spec = arm.ArmSpec.from_table1()
+    assert str(targets.level_head_poses(path)["fingerprint"]) == workspace.model_fingerprint(
+        spec, layouts.build("antagonist_pairs"))
+    assert layouts.target_file("paper") == targets.DATA_PATH  # the tasks' default stays
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=layouts.task_kwargs("antagonist_pairs"))
+    assert env.action_spec().shape == (9,)
+    assert len(env.task.target_pool) == len(targets.training_targets(path)) > 0
+    with pytest.raises(FileNotFoundError, match="no target file ships for layout 'cranial_every'"):
+        layouts.target_file("cranial_every")
+
+
 def script(name):
     path = os.path.join(os.path.dirname(sys.executable), name)
     path = path if os.path.exists(path) else shutil.which(name)
