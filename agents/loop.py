@@ -75,7 +75,7 @@ class EnvironmentLoop:
                 self.episode_return, self.episode_length = 0.0, 0
             obs = self._obs
             policy_action = self._act(obs)
-            env_action = adapter.to_env(policy_action)
+            env_action = adapter.to_env(policy_action, obs)
             timestep = env.step(env_action)
             reward, discount, taken = float(timestep.reward), float(timestep.discount), 1
             next_obs = flatten(timestep.observation)

@@ -79,6 +79,14 @@ def check_action(action: np.ndarray, control_range: np.ndarray) -> np.ndarray:
     return np.clip(action, low, high)
 
 
+def normalized_command(physics) -> np.ndarray:
+    """The tendon inputs now commanded, mapped onto [-1, 1] of their control range (an agent
+    that changes the inputs step by step needs to see where they are: a slack tendon's
+    contraction does not show it)."""
+    low, high = physics.arm_control_range().T
+    return (physics.arm_control() - 0.5 * (high + low)) / (0.5 * (high - low))
+
+
 class Reach(base.Task):
     """Bring the head to a target position (and, from lesson 2, hold it level)."""
 
@@ -137,12 +145,13 @@ class Reach(base.Task):
         if self.randomizer is not None:
             self.randomizer.apply(physics, self.random)
         if self.initial_state == "continue" and self._last_state is not None:
-            qpos, qvel, act = self._last_state
+            qpos, qvel, act, command = self._last_state
             with physics.reset_context():
                 physics.data.qpos[:] = qpos
                 physics.data.qvel[:] = qvel
                 if act.size:
                     physics.data.act[:] = act
+                physics.set_arm_control(command)  # the servos keep their command, as a real arm's would
         self.target_position = self.next_target()
         super().initialize_episode(physics)
 
@@ -166,7 +175,7 @@ class Reach(base.Task):
         # Remember where the arm is for the next episode of a "continue" lesson.
         if physics.divergence is None:
             self._last_state = (physics.data.qpos.copy(), physics.data.qvel.copy(),
-                                physics.data.act.copy())
+                                physics.data.act.copy(), physics.arm_control().copy())
         else:
             self._last_state = None
 
@@ -211,7 +220,7 @@ class Reach(base.Task):
 
     # --- dm_control Task API ------------------------------------------------
     def get_observation(self, physics):
-        """Table 2 (head position, head velocity, joint angles) + goal + tendon state.
+        """Table 2 (head position, head velocity, joint angles) + goal + tendon state and command.
 
         Units are chosen so that every entry is of order one: metres, m/s,
         radians, and tendon forces as a fraction of the actuator's limit.
@@ -231,6 +240,7 @@ class Reach(base.Task):
         obs["head_attitude"] = np.array([np.radians(physics.head_attitude())])
         obs["tendon_contraction"] = physics.tendon_contractions()
         obs["tendon_tension"] = physics.tendon_forces() / physics.tendon_max_forces()
+        obs["tendon_command"] = normalized_command(physics)
         return obs
 
     def get_reward(self, physics):

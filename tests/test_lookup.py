@@ -99,3 +99,71 @@ def test_evaluation_judges_success_with_the_tasks_own_tolerances():
         results[tolerance] = evaluation._episode_summary(series)
     assert results[0.05]["success"] and results[0.05]["tolerances"][0] == 0.05
     assert not results[1e-4]["success"] and results[1e-4]["tolerances"][0] == 1e-4
+
+
+def test_residual_adapter_offsets_the_lookup_by_a_bounded_correction(flattener):
+    from agents.actors import ResidualAdapter
+    env = make_environment("robostrich", "lesson2", 0)
+    spec = env.action_spec()
+    lookup = LookupPolicy(flattener)
+    adapter = ResidualAdapter(spec, lookup, scale=0.25)
+    obs = flattener(env.reset().observation)
+    base = lookup.select_action(obs)
+    np.testing.assert_allclose(adapter.to_env(np.zeros(9), obs), base)  # zero residual = the lookup
+    half = 0.5 * (spec.maximum - spec.minimum)
+    np.testing.assert_allclose(adapter.to_env(np.ones(9), obs), np.minimum(base + 0.25 * half, spec.maximum))
+    np.testing.assert_allclose(adapter.to_env(-np.ones(9), obs), np.maximum(base - 0.25 * half, spec.minimum))
+    with pytest.raises(ValueError, match="observation"):
+        adapter.to_env(np.zeros(9))
+    with pytest.raises(ValueError, match="residual scale"):
+        ResidualAdapter(spec, lookup, scale=0.0)
+    with pytest.raises(ValueError, match="do not mix"):
+        SACConfig(residual_scale=0.25, her_ratio=0.5)
+
+
+def test_untrained_residual_agent_is_the_lookup(flattener, tmp_path):
+    """The policy's mean head starts at zero, so before any update the residual agent's
+    deterministic action is the lookup's and it lands where the lookup lands."""
+    config = SACConfig(residual_scale=0.25, min_replay_size=10)
+    run = CurriculumRun(parse_plan("lesson2:100"), config, seed=0, run_dir=str(tmp_path / "run"))
+    actor = SACBuilder.make_eval_actor(run.loop)
+    target = targets.heldout_targets()[:2]
+    agent = evaluation.evaluate_heldout(actor, run.loop.flattener, "robostrich", "lesson2", targets=target)
+    base = evaluation.evaluate_heldout(LookupPolicy(flattener), flattener, "robostrich", "lesson2", targets=target)
+    for a, b in zip(agent["episodes"], base["episodes"]):
+        assert a["final_position_error"] == pytest.approx(b["final_position_error"], abs=1e-9)
+    run.run()  # training moves it: after 100 steps with updates the policy is no longer exactly zero
+    obs = run.loop.flattener(make_environment("robostrich", "lesson2", 0).reset().observation)
+    assert np.abs(SACBuilder.make_eval_actor(run.loop).policy_action(obs)).max() > 0
+
+
+def test_incremental_adapter_moves_the_commanded_inputs_step_by_step(flattener):
+    from agents.actors import IncrementalAdapter
+    env = make_environment("robostrich", "lesson2", 0)
+    spec = env.action_spec()
+    adapter = IncrementalAdapter(spec, flattener, step=0.05)
+    env.reset()
+    held = 0.5 * (spec.minimum + spec.maximum) + 0.3 * (spec.maximum - spec.minimum) * np.linspace(-1, 1, 9)
+    obs = flattener(env.step(held).observation)
+    np.testing.assert_allclose(adapter.to_env(np.zeros(9), obs), held, atol=1e-6)  # no change: the command stays
+    half = 0.5 * (spec.maximum - spec.minimum)
+    np.testing.assert_allclose(adapter.to_env(np.ones(9), obs), held + 0.05 * half, atol=1e-6)
+    np.testing.assert_allclose(adapter.to_env(np.full(9, -1.0), flattener(env.step(spec.minimum).observation)),
+                               spec.minimum, atol=1e-6)  # clipped at the bottom of the range
+    with pytest.raises(ValueError, match="tendon_command"):
+        IncrementalAdapter(spec, ObservationFlattener(collections.OrderedDict(
+            position=specs.Array((2,), np.float64))), step=0.05)
+
+
+def test_continued_episode_keeps_the_servo_command():
+    """Lesson 3 starts where the last episode ended, inputs included (an incremental agent
+    reads them from the observation; a real servo keeps its command)."""
+    env = make_environment("robostrich", "lesson3", 0)
+    spec = env.action_spec()
+    held = spec.minimum + 0.6 * (spec.maximum - spec.minimum)
+    timestep = env.reset()
+    while not timestep.last():
+        timestep = env.step(held)
+    first = env.reset().observation
+    np.testing.assert_allclose(env.physics.arm_control(), held)
+    np.testing.assert_allclose(first["tendon_command"], np.full(9, 0.2), atol=1e-9)

@@ -1,7 +1,7 @@
 """Wires networks, learner, replay, actor and loop for one environment's specs."""
 import jax
 
-from agents.actors import ActionAdapter, Actor
+from agents.actors import ActionAdapter, Actor, IncrementalAdapter, ResidualAdapter
 from agents.goals import GoalRelabeler
 from agents.loop import EnvironmentLoop
 from agents.replay import ObservationFlattener, ReplayBuffer
@@ -26,9 +26,15 @@ class SACBuilder:
         if len(action_spec.shape) != 1:
             raise ValueError(f"expected a flat action spec, got shape {action_spec.shape}")
         flattener = ObservationFlattener(env.observation_spec())
-        adapter = ActionAdapter(action_spec)
+        if cfg.residual_scale > 0:
+            from agents.lookup import LookupPolicy
+            adapter = ResidualAdapter(action_spec, LookupPolicy(flattener), cfg.residual_scale)
+        elif cfg.action_increment > 0:
+            adapter = IncrementalAdapter(action_spec, flattener, cfg.action_increment)
+        else:
+            adapter = ActionAdapter(action_spec)
         networks = make_networks(flattener.size, adapter.size, cfg.hidden_sizes, cfg.log_std_min, cfg.log_std_max,
-                                 cfg.critic_layer_norm)
+                                 cfg.critic_layer_norm, zero_policy_mean=cfg.residual_scale > 0)
         key = jax.random.PRNGKey(seed)
         learner_key, actor_key = jax.random.split(key)
         learner = SACLearner(networks, cfg, learner_key)
@@ -36,7 +42,8 @@ class SACBuilder:
         goal_width = relabeler.goal_size + 1 if relabeler is not None else 0  # + attitude error
         replay = ReplayBuffer(flattener.size, adapter.size, cfg.max_replay_size, seed=seed,
                               goal_width=goal_width, repeat=cfg.action_repeat)
-        actor = Actor(networks, adapter, learner.policy_params, key=actor_key, deterministic=False)
+        actor = Actor(networks, adapter, learner.policy_params, key=actor_key, deterministic=False,
+                      noise_correlation=cfg.noise_correlation)
         loop = EnvironmentLoop(env, actor, replay, learner, cfg, flattener, seed=seed)
         return loop
 

@@ -2,6 +2,8 @@
 import dataclasses
 from typing import Optional, Tuple
 
+import numpy as np
+
 
 @dataclasses.dataclass(frozen=True)
 class SACConfig:
@@ -46,6 +48,20 @@ class SACConfig:
     # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
     # replay then carry lesson-2 rewards instead of the ones they were collected with.
     relabel_rewards: bool = True
+    # Residual policy on the lookup baseline (agents/lookup.py) on tasks with a target_position
+    # observation: the action is the lookup's stored input plus this fraction of each tendon's
+    # half-range times the policy's output (0 = off: the policy outputs the whole input).
+    residual_scale: float = 0.0
+    # Incremental actions on tasks with a tendon_command observation: the policy changes each
+    # input by at most this fraction of its half-range per decision (0 = off: absolute inputs).
+    action_increment: float = 0.0
+    # Weight of a penalty on the squared deterministic action in the actor loss (times the
+    # critic's mean |Q|, as TD3+BC): keeps a residual policy at its base unless the critic
+    # clearly prefers a correction (0 = off, plain SAC's actor loss; 0.4 is TD3+BC's alpha = 2.5).
+    action_anchor: float = 0.0
+    # Exploration noise correlated over time (AR(1) coefficient per decision, agents/actors.py):
+    # 0 = white noise as published; 0.97 at one decision per 8 ms is correlated over ~0.25 s.
+    noise_correlation: float = 0.0
 
     def __post_init__(self):
         if min(self.batch_size, self.updates_per_call, self.env_steps_per_call, self.action_repeat) <= 0:
@@ -54,6 +70,19 @@ class SACConfig:
             raise ValueError(f"tau must be in (0, 1], got {self.tau}")
         if not 0.0 <= self.her_ratio <= 1.0:
             raise ValueError(f"her_ratio must be in [0, 1], got {self.her_ratio}")
+        if not 0.0 <= self.residual_scale <= 2.0:
+            raise ValueError(f"residual_scale must be in [0, 2] (0 = no residual), got {self.residual_scale}")
+        if self.residual_scale > 0 and self.her_ratio > 0:
+            raise ValueError("residual_scale and her_ratio do not mix: a relabelled goal changes the lookup's "
+                             "base action, so the stored residual would no longer mean what it did")
+        if not (np.isfinite(self.action_anchor) and self.action_anchor >= 0):
+            raise ValueError(f"action_anchor must be a finite weight >= 0, got {self.action_anchor}")
+        if not 0.0 <= self.noise_correlation < 1.0:
+            raise ValueError(f"noise_correlation must be in [0, 1), got {self.noise_correlation}")
+        if not 0.0 <= self.action_increment <= 2.0:
+            raise ValueError(f"action_increment must be in [0, 2] (0 = absolute inputs), got {self.action_increment}")
+        if self.action_increment > 0 and self.residual_scale > 0:
+            raise ValueError("action_increment and residual_scale are two different action spaces; choose one")
         if self.min_replay_size > self.max_replay_size:
             raise ValueError("min_replay_size exceeds max_replay_size")
         object.__setattr__(self, "hidden_sizes", tuple(int(h) for h in self.hidden_sizes))
@@ -78,7 +107,9 @@ class SACConfig:
         values = dict(batch_size=256, learning_rate=3e-4, discount=0.99, tau=0.005, target_entropy=None,
                       init_temperature=1.0, hidden_sizes=(256, 256), min_replay_size=10_000,
                       max_replay_size=1_000_000, updates_per_call=8, env_steps_per_call=8, action_repeat=1,
-                      reward_scale=1.0, critic_layer_norm=False, her_ratio=0.0, relabel_rewards=False)
+                      reward_scale=1.0, critic_layer_norm=False, her_ratio=0.0, relabel_rewards=False,
+                      residual_scale=0.0, action_increment=0.0,
+                      action_anchor=0.0, noise_correlation=0.0)
         values.update(overrides)
         return cls(**values)
 

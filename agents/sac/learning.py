@@ -80,7 +80,14 @@ def make_update_fn(networks: SACNetworks, config: SACConfig):
     def actor_loss(policy_params, q_params, alpha, obs, key):
         action, log_prob = networks.sample(policy_params, obs, key)
         q1, q2 = networks.q_apply(q_params, obs, action)
-        return jnp.mean(alpha * log_prob - jnp.minimum(q1, q2)), log_prob  # eq. 7
+        loss = jnp.mean(alpha * log_prob - jnp.minimum(q1, q2))  # eq. 7
+        if config.action_anchor > 0:
+            # Pull the deterministic action toward 0 (a residual policy's base), scaled by the
+            # critic's magnitude as TD3+BC does, so the anchor means the same at any return scale.
+            q_scale = jax.lax.stop_gradient(jnp.mean(jnp.abs(jnp.minimum(q1, q2)))) + 1e-6
+            anchor = jnp.mean(networks.mode(policy_params, obs) ** 2)
+            loss = loss + config.action_anchor * q_scale * anchor
+        return loss, log_prob
 
     def alpha_loss(log_alpha, log_prob):
         # eq. 8: raise alpha when the entropy -log_prob falls below the target.

@@ -48,15 +48,17 @@ def tanh_gaussian_log_prob(u, mean, log_std):
 
 def make_networks(obs_size: int, action_size: int, hidden_sizes: Sequence[int] = (256, 256),
                   log_std_min: float = -5.0, log_std_max: float = 2.0,
-                  critic_layer_norm: bool = False) -> SACNetworks:
+                  critic_layer_norm: bool = False, zero_policy_mean: bool = False) -> SACNetworks:
     """Cached: equal arguments give the same object, so learners and actors share compiled functions.
 
     ``critic_layer_norm`` normalises each hidden layer of the critics (before the ReLU):
     it keeps Q-values' gradients well scaled when returns are large and lets a critic
     learn fast at one update per step (Ball et al. 2023, "RLPD").
+    ``zero_policy_mean`` starts the policy's mean head at zero weights, so the initial
+    deterministic action is exactly 0: a residual policy then starts as its base controller.
     """
     return _make_networks(int(obs_size), int(action_size), tuple(int(h) for h in hidden_sizes),
-                          float(log_std_min), float(log_std_max), bool(critic_layer_norm))
+                          float(log_std_min), float(log_std_max), bool(critic_layer_norm), bool(zero_policy_mean))
 
 
 def _normalised_critic(x, hidden_sizes, name: str):
@@ -70,11 +72,12 @@ def _normalised_critic(x, hidden_sizes, name: str):
 
 @functools.lru_cache(maxsize=None)
 def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max,
-                   critic_layer_norm=False) -> SACNetworks:
+                   critic_layer_norm=False, zero_policy_mean=False) -> SACNetworks:
 
     def policy_fn(obs):
         h = hk.nets.MLP(hidden_sizes, activation=jax.nn.relu, activate_final=True, name="policy_torso")(obs)
-        mean = hk.Linear(action_size, name="mean")(h)
+        mean_init = hk.initializers.Constant(0.0) if zero_policy_mean else None
+        mean = hk.Linear(action_size, w_init=mean_init, name="mean")(h)
         raw = hk.Linear(action_size, name="log_std")(h)
         # Squash log_std smoothly into its range (as CleanRL) rather than clipping away the gradient.
         log_std = log_std_min + 0.5 * (log_std_max - log_std_min) * (jnp.tanh(raw) + 1.0)
