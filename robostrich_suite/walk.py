@@ -2,10 +2,11 @@
 
     robostrich-walk [--task head_stabilize] [--tendons zero|sine] [--gait trot|FILE] --out out/walk
 
-writes ``out/walk.rrd`` (the robot over sim time, the head's path, the series
-below as scalars) and ``out/walk.png`` (trunk and head height, speeds, the head's
+writes ``out/walk/walk.rrd`` (the robot over sim time, the head's path, the series
+below as scalars) and ``out/walk/walk.png`` (trunk and head height, speeds, the head's
 distance ahead of the trunk, head attitude and trunk pitch over time), so a user
-sees the perturbation the arm gets from walking.
+sees the perturbation the arm gets from walking.  ``--out`` is a directory, as for
+every ``robostrich-*`` command.
 """
 from __future__ import annotations
 
@@ -157,10 +158,22 @@ def _at_least_one_step(text: str) -> float:
     return seconds
 
 
+def out_directory_problem(out: pathlib.Path) -> str | None:
+    """Why ``out`` cannot be the output directory, or None.  Before, ``--out`` was a file
+    stem (``--out out/walk`` wrote out/walk.png); a stem still works (it is now the
+    directory), but a file name with the tool's suffixes, or an existing file, is refused."""
+    if out.suffix.lower() in (".png", ".rrd"):
+        return (f"'{out}' names a file; --out is a directory (writes DIR/walk.png and "
+                f"DIR/walk.rrd), e.g. --out {out.with_suffix('')}")
+    if out.exists() and not out.is_dir():
+        return f"'{out}' is a file; --out is a directory (writes DIR/walk.png and DIR/walk.rrd)"
+    return None
+
+
 def main(argv=None) -> None:
     """The walk tool: trot with scripted tendons, write a Rerun recording and a PNG."""
     parser = argparse.ArgumentParser(
-        description="Walk the quadruped with the arm on it; write out/walk.rrd and out/walk.png "
+        description="Walk the quadruped with the arm on it; write walk.rrd and walk.png under --out "
                     "(trunk and head height, speed and attitude over time).")
     parser.add_argument("--task", default="head_stabilize", choices=list(SUITE),
                         help="robostrich_a1 task whose gait and trunk heights to run")
@@ -172,14 +185,18 @@ def main(argv=None) -> None:
                         help="gait file (CSV, see robostrich_suite.gait) or 'trot' for the "
                              "generator; default: the shipped file")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/walk"),
-                        help="output path without suffix: writes OUT.rrd and OUT.png")
+                        help="output directory: writes OUT/walk.rrd and OUT/walk.png "
+                             "(default: %(default)s)")
     parser.add_argument("--no-rrd", action="store_true", help="skip the Rerun recording")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
+    problem = out_directory_problem(args.out)
+    if problem:
+        parser.error(f"argument --out: {problem}")
     gait = gait_lib.TrotGait() if args.gait == "trot" else args.gait
-    rrd = None if args.no_rrd else args.out.with_suffix(".rrd")
+    rrd = None if args.no_rrd else args.out / "walk.rrd"
     series = record_walk(args.task, args.seconds, args.tendons, gait, rrd, args.seed)
-    png = args.out.with_suffix(".png")
+    png = args.out / "walk.png"
     plot_walk(series, png, f"robostrich_a1/{args.task}, tendons: {args.tendons}")
     walked = np.sum(series["trunk_speed"]) * CONTROL_TIMESTEP
     print(f"{len(series['time'])} steps, {series['time'][-1]:.2f} s: "

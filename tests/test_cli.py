@@ -99,7 +99,7 @@ def test_evaluate_exits_zero_on_a_checkpoint(trained, tmp_path):
 def test_the_other_scripts_exit_zero(tmp_path):
     runs = {  # cheap real invocations, run side by side
         "robostrich-export-xml": ["--out", tmp_path / "xml"],
-        "robostrich-walk": ["--seconds", "0.2", "--no-rrd", "--out", tmp_path / "walk" / "walk"],
+        "robostrich-walk": ["--seconds", "0.2", "--no-rrd", "--out", tmp_path / "walk"],
         "robostrich-movement": ["--out", tmp_path / "movement", "--patterns", "lever", "--no-match-travel",
                                 "--ramp-time", "0.05", "--no-recording", "--no-progress"],
         "robostrich-workspace": ["--out", tmp_path / "workspace", "--samples", "200", "--edge-samples", "200",
@@ -109,6 +109,7 @@ def test_the_other_scripts_exit_zero(tmp_path):
     for name, process in processes.items():
         assert_succeeded(finish(process))
     assert (tmp_path / "movement" / "lever.png").exists() and (tmp_path / "workspace" / "workspace.png").exists()
+    assert (tmp_path / "walk" / "walk.png").exists()  # --out is a directory for every command
 
 
 def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):

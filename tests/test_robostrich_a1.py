@@ -249,11 +249,25 @@ def test_bad_task_options_raise():
             trunk_heights=gait.TrunkHeightSchedule((0, 1), (0.27, 0.5))))
 
 
-def test_walk_tool_writes_a_recording_and_a_plot(tmp_path, capsys):
+def test_walk_tool_writes_a_recording_and_a_plot_into_its_out_directory(tmp_path, capsys):
+    """--out is a directory, as for robostrich-movement and robostrich-workspace (issue 11)."""
     walk.main(["--seconds", "0.4", "--tendons", "sine", "--out", str(tmp_path / "walk")])
-    assert (tmp_path / "walk.rrd").stat().st_size > 10_000
-    assert (tmp_path / "walk.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (tmp_path / "walk" / "walk.rrd").stat().st_size > 10_000
+    assert (tmp_path / "walk" / "walk.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["walk"]
     assert "mean forward speed" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("out", ["walk.png", "walk.rrd", "a_file"])
+def test_walk_tool_refuses_a_file_as_out(tmp_path, capsys, out):
+    """The old usage (a file name) and an existing file get a usage error naming --out."""
+    (tmp_path / "a_file").write_text("")
+    with pytest.raises(SystemExit) as exit_info:
+        walk.main(["--seconds", "0.1", "--no-rrd", "--out", str(tmp_path / out)])
+    assert exit_info.value.code == 2
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "argument --out:" in last and "is a directory" in last
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
 
 
 def test_walk_series_show_the_trot_and_the_scripted_nod():
