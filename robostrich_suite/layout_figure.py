@@ -24,7 +24,7 @@ def _region_panel(ax, region: coverage_lib.BlueRegion, held: np.ndarray, covered
                                edgecolor="#1b7837" if is_held else "0.55"))
     ax.scatter(*region.head_position.T, s=5, c="tab:blue", lw=0, zorder=3)
     if len(held):
-        ax.scatter(*held.T, s=7, c="k", marker="x", lw=0.7, zorder=4)
+        ax.scatter(*held.T, s=6, c="k", marker="x", lw=0.6, alpha=0.7, zorder=4)
     ax.plot(*base_xz, "ko", ms=5, zorder=5)
 
 
@@ -85,7 +85,7 @@ def plot(cases, region: coverage_lib.BlueRegion, results, path) -> pathlib.Path:
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     columns = len(cases)
-    fig, axes = plt.subplots(2, columns, figsize=(3.3 * columns, 7.2), squeeze=False,
+    fig, axes = plt.subplots(2, columns, figsize=(max(3.3 * columns, 10.0), 7.2), squeeze=False,
                              gridspec_kw=dict(height_ratios=[2.2, 1.3]))
     base_xz = workspace.base_joint_xz(workspace.frame_physics(cases[0].spec, cases[0].layout),
                                       cases[0].spec)
@@ -121,7 +121,7 @@ def plot(cases, region: coverage_lib.BlueRegion, results, path) -> pathlib.Path:
         Line2D([], [], ls="", marker="s", ms=4, color="0.3", label="anchor on the base"),
         Line2D([], [], ls="", marker=">", ms=5, color="0.3", label="insertion (dots: holes passed)"),
     ]
-    fig.legend(handles=handles, loc="lower center", ncol=min(5, max(3, columns)), fontsize=7.5,
+    fig.legend(handles=handles, loc="lower center", ncol=3 if columns < 3 else 5, fontsize=7.5,
                frameon=False)
     fig.suptitle("Tendon layouts on the Table 1 links: blue region of Fig. 6 held level "
                  "(top), routing on the straightened neck (bottom)", fontsize=10)
