@@ -21,7 +21,6 @@ from dm_control.utils import containers
 
 from robostrich_suite import arm as arm_lib
 from robostrich_suite import arm_physics, reach
-from robostrich_suite import targets as target_lib
 
 CONTROL_TIMESTEP = 0.008  # s (paper Sec. 4.2)
 PHYSICS_TIMESTEP = 0.002  # s; 4 substeps per control step
@@ -51,10 +50,18 @@ def _environment(task, time_limit, arm_spec, tendon_layout, environment_kwargs):
     return control.Environment(physics, task, time_limit=time_limit, **environment_kwargs)
 
 
+def _warn_if_other_arm(arm_spec, tendon_layout) -> None:
+    """targets.warn_if_other_arm, imported here: a module-level import would put
+    robostrich_suite.targets in sys.modules at package import, and
+    `python -m robostrich_suite.targets` would print runpy's RuntimeWarning."""
+    from robostrich_suite import targets
+    targets.warn_if_other_arm(arm_spec, tendon_layout)
+
+
 def _lesson(reward, initial_state, time_limit, random, environment_kwargs, arm_spec,
             tendon_layout, task_kwargs):
     if "target_pool" not in task_kwargs:
-        target_lib.warn_if_other_arm(arm_spec, tendon_layout)
+        _warn_if_other_arm(arm_spec, tendon_layout)
     task = reach.Reach(reward=reward, initial_state=initial_state, random=random, **task_kwargs)
     return _environment(task, time_limit, arm_spec, tendon_layout, environment_kwargs)
 
@@ -89,7 +96,7 @@ def track(time_limit=None, random=None, environment_kwargs=None, arm_spec=None,
           **task_kwargs):
     """Reach three targets in order (Fig. 7); per-step errors are in the observation."""
     if targets is None:
-        target_lib.warn_if_other_arm(arm_spec, tendon_layout)
+        _warn_if_other_arm(arm_spec, tendon_layout)
     task = reach.Track(targets=targets, steps_per_target=steps_per_target, random=random,
                        **task_kwargs)
     if time_limit is None:

@@ -62,7 +62,6 @@ from dm_control.utils import containers
 
 from robostrich_suite import arm as arm_lib
 from robostrich_suite import arm_physics, reach
-from robostrich_suite import targets as target_lib
 from robostrich_suite import gait as gait_lib
 from robostrich_suite import quadruped as quad
 
@@ -510,7 +509,8 @@ def lesson4_heights(random, time_limit: float = LESSON4_TIME_LIMIT,
 def _lesson(reward, initial_state, time_limit, random, environment_kwargs, arm_spec,
             tendon_layout, task_kwargs, legs="stand", trunk_heights=None):
     if "target_pool" not in task_kwargs:
-        target_lib.warn_if_other_arm(arm_spec, tendon_layout)
+        from robostrich_suite import targets  # here, not at import: see robostrich._warn_if_other_arm
+        targets.warn_if_other_arm(arm_spec, tendon_layout)
     task = QuadrupedReach(reward=reward, initial_state=initial_state, random=random, legs=legs,
                           trunk_heights=trunk_heights, **task_kwargs)
     return _environment(task, time_limit, arm_spec, tendon_layout, environment_kwargs)

@@ -59,3 +59,17 @@ def test_another_arm_gets_a_warning_and_its_own_targets(tmp_path):
             tendon_layout=slips, target_pool=pool))
     env.reset()
     assert any(np.allclose(env.task.target_position, p) for p in pool)
+
+
+def test_running_the_module_prints_no_runpy_warning():
+    """`python -m robostrich_suite.targets` (README) without runpy's RuntimeWarning about sys.modules:
+    importing the package must not import the targets module (issue 11)."""
+    import os
+    import subprocess
+    import sys
+    env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+    result = subprocess.run([sys.executable, "-W", "default", "-m", "robostrich_suite.targets", "--help"],
+                            capture_output=True, text=True, env=env, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "RuntimeWarning" not in result.stderr and "Warning" not in result.stderr, result.stderr
+    assert "--samples" in result.stdout
