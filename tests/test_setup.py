@@ -1,0 +1,61 @@
+"""What setup.py promises matches what its pinned dependencies need, and the README says the same (issue 11)."""
+import ast
+import importlib.metadata
+import pathlib
+import re
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+def setup_arguments() -> dict:
+    """The literal keyword arguments of setup() in setup.py."""
+    tree = ast.parse((ROOT / "setup.py").read_text())
+    call = next(node for node in ast.walk(tree) if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "setup")
+    return {kw.arg: ast.literal_eval(kw.value) for kw in call.keywords
+            if kw.arg in ("python_requires", "install_requires", "extras_require")}
+
+
+def test_python_requires_is_what_the_pinned_dependencies_need():
+    specifiers = pytest.importorskip("packaging.specifiers")
+    version = pytest.importorskip("packaging.version")
+    arguments = setup_arguments()
+    floor = re.fullmatch(r">=(\d+\.\d+)", arguments["python_requires"])
+    assert floor, arguments["python_requires"]
+    lowest = version.Version(floor.group(1))
+    pins = arguments["install_requires"] + [p for extra in arguments["extras_require"].values() for p in extra]
+    needs = {}
+    for pin in pins:
+        name = re.split(r"[=<>!~\[ ]", pin, maxsplit=1)[0]
+        try:
+            requires = importlib.metadata.metadata(name).get("Requires-Python")
+        except importlib.metadata.PackageNotFoundError:
+            continue  # an extra that is not installed here
+        if requires:
+            needs[name] = requires
+            assert lowest in specifiers.SpecifierSet(requires), (
+                f"python_requires {arguments['python_requires']} but {pin} needs Python {requires}")
+    assert needs, "no installed pin to check against"
+    # ... and it is the tightest of them: python_requires claims no version none of them rules out.
+    assert any(version.Version(f"{lowest.major}.{lowest.minor - 1}") not in specifiers.SpecifierSet(r)
+               for r in needs.values()), (arguments["python_requires"], needs)
+
+
+def test_readme_states_the_same_python_version():
+    floor = setup_arguments()["python_requires"].removeprefix(">=")
+    readme = (ROOT / "README.md").read_text()
+    stated = set(re.findall(r"Python (\d+\.\d+)\+", readme))
+    assert stated == {floor}, f"README says Python {stated}, setup.py {floor}+"
+
+
+def test_readme_python_snippets_run_on_their_own():
+    """Each ```python block of the README runs in a fresh namespace: it imports what it uses (issue 11)."""
+    readme = (ROOT / "README.md").read_text()
+    snippets = re.findall(r"```python\n(.*?)```", readme, flags=re.S)
+    assert len(snippets) >= 2
+    for number, code in enumerate(snippets, 1):
+        try:
+            exec(compile(code, f"README.md python snippet {number}", "exec"), {})
+        except Exception as error:  # noqa: BLE001 - name the snippet that failed
+            raise AssertionError(f"README python snippet {number} fails: {error!r}") from error
