@@ -29,7 +29,32 @@ def _choose_headless_renderer():
 
 _choose_headless_renderer()
 
-from robostrich_suite import robostrich  # noqa: E402  (after the renderer choice: it imports dm_control)
+_RENDERER_HINTS = {
+    "osmesa": "OSMesa needs the OSMesa library (Debian/Ubuntu: apt-get install libosmesa6)",
+    "egl": "EGL needs libEGL with a GPU driver or Mesa (Debian/Ubuntu: apt-get install libegl1)",
+    "glfw": "GLFW needs a display (DISPLAY) and libglfw",
+}
+
+
+def _renderer_error(error: BaseException) -> ImportError:
+    """dm_control loads the MUJOCO_GL backend at import; when that fails deep inside PyOpenGL
+    (osmesa without libOSMesa: "'NoneType' object has no attribute 'glGetError'"), say which
+    backend failed and what to do."""
+    backend = os.environ.get("MUJOCO_GL", "")
+    hint = _RENDERER_HINTS.get(backend.lower(), "see MuJoCo's rendering documentation")
+    return ImportError(
+        f"dm_control could not load the MUJOCO_GL={backend!r} renderer "
+        f"({type(error).__name__}: {error}). {hint}; or set MUJOCO_GL=egl, or unset MUJOCO_GL and "
+        f"robostrich_suite picks a headless backend that is installed (simulation needs none)")
+
+
+try:
+    from robostrich_suite import robostrich  # noqa: E402  (after the renderer choice: it imports dm_control)
+except (ImportError, AttributeError, OSError) as _error:
+    import traceback
+    if any("_render" in frame.filename for frame in traceback.extract_tb(_error.__traceback__)):
+        raise _renderer_error(_error) from _error
+    raise
 
 _DOMAINS = collections.OrderedDict(
     (name, module) for name, module in [("robostrich", robostrich)])
@@ -52,6 +77,20 @@ TASKS_BY_DOMAIN = collections.OrderedDict(
     (domain, tuple(module.SUITE)) for domain, module in _DOMAINS.items())
 CURRICULUM_TASKS = tuple((domain, task) for domain, module in _DOMAINS.items()
                          for task in module.SUITE.tagged("curriculum"))
+
+
+def _register_gymnasium_environments():
+    """With gymnasium installed (the ``gym`` extra), ``gymnasium.make("robostrich/lesson2-v0")``
+    works after ``import robostrich_suite``: see ``robostrich_suite.gym_adapter``."""
+    try:
+        import gymnasium  # noqa: F401
+    except ImportError:
+        return
+    from robostrich_suite import gym_adapter
+    gym_adapter.register_environments()
+
+
+_register_gymnasium_environments()
 
 
 def load(domain_name, task_name, task_kwargs=None, environment_kwargs=None, visualize_reward=False):

@@ -11,6 +11,19 @@ time-limit end (discount 1) is ``truncated``; a divergence (discount 0) is
 ``terminated``.  With ``normalize_actions=True`` (the default, as most gymnasium
 agents expect) actions live in [-1, 1] and are mapped linearly onto the
 tendon contraction range; pass False for contractions in metres.  Requires the ``gym`` extra: ``pip install -e '.[gym]'``.
+
+Every task is registered with gymnasium when ``robostrich_suite`` is imported
+(``robostrich/lesson2-v0``, ``robostrich_a1/head_stabilize-v0``, ...)::
+
+    import gymnasium, robostrich_suite
+    env = gymnasium.make("robostrich/lesson2-v0", render_mode="rgb_array", time_limit=1.0)
+
+Keyword arguments other than ``render_mode``, ``seed``, ``normalize_actions``,
+``width``, ``height`` and ``camera`` are the task's ``task_kwargs``.
+``render_mode="rgb_array"`` makes ``render()`` return an (height, width, 3) uint8
+frame from the model's ``side`` camera; it needs an offscreen OpenGL backend
+(``MUJOCO_GL=egl``, or ``osmesa`` with libOSMesa installed), which
+``robostrich_suite`` picks itself when no display is set.
 """
 from __future__ import annotations
 
@@ -24,10 +37,20 @@ import robostrich_suite
 class GymnasiumEnv(gymnasium.Env):
     """Wraps a ``dm_env.Environment`` with dict observations and a bounded action."""
 
-    metadata = {"render_modes": []}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 125}
 
-    def __init__(self, dm_environment, normalize_actions: bool = True):
+    def __init__(self, dm_environment, normalize_actions: bool = True, render_mode: str | None = None,
+                 width: int = 640, height: int = 480, camera: str = "side"):
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, "
+                             f"got {render_mode!r}")
+        if not (isinstance(width, int) and isinstance(height, int) and width > 0 and height > 0):
+            raise ValueError(f"width and height must be positive whole numbers of pixels, got {width!r}, {height!r}")
         self.dm_env = dm_environment
+        self.render_mode = render_mode
+        self.width, self.height, self.camera = width, height, camera
+        # One frame per control step (0.008 s: 125 frames per second).
+        self.metadata = {**self.metadata, "render_fps": int(round(1.0 / dm_environment.control_timestep()))}
         action_spec = dm_environment.action_spec()
         self._action_low = np.asarray(action_spec.minimum, np.float64)
         self._action_high = np.asarray(action_spec.maximum, np.float64)
@@ -84,11 +107,44 @@ class GymnasiumEnv(gymnasium.Env):
         return (self._flatten(timestep.observation), float(timestep.reward), bool(terminated),
                 bool(truncated), info)
 
+    def render(self):
+        """An (height, width, 3) uint8 frame of the scene (``render_mode="rgb_array"``); None
+        (with gymnasium's warning) when the environment was made without a render mode."""
+        if self.render_mode is None:
+            gymnasium.logger.warn("render() called without a render_mode; make the environment "
+                                  "with render_mode='rgb_array'")
+            return None
+        physics = self.dm_env.physics
+        try:
+            camera = physics.model.name2id(self.camera, "camera")
+        except ValueError:
+            camera = -1  # a model without that camera: MuJoCo's free camera
+        return physics.render(height=self.height, width=self.width, camera_id=camera)
+
 
 def make(domain_name: str, task_name: str, seed: int | None = None,
-         normalize_actions: bool = True, **task_kwargs) -> GymnasiumEnv:
-    """``robostrich_suite.load`` + the gymnasium wrapper."""
+         normalize_actions: bool = True, render_mode: str | None = None, width: int = 640,
+         height: int = 480, camera: str = "side", **task_kwargs) -> GymnasiumEnv:
+    """``robostrich_suite.load`` + the gymnasium wrapper (also the entry point of the
+    registered ``DOMAIN/TASK-v0`` environments)."""
     if seed is not None:
         task_kwargs["random"] = seed
     return GymnasiumEnv(robostrich_suite.load(domain_name, task_name, task_kwargs=task_kwargs),
-                        normalize_actions=normalize_actions)
+                        normalize_actions=normalize_actions, render_mode=render_mode,
+                        width=width, height=height, camera=camera)
+
+
+make.metadata = GymnasiumEnv.metadata  # gymnasium.make reads the entry point's render modes here
+
+
+def register_environments() -> list[str]:
+    """Register every task as ``DOMAIN/TASK-v0`` with gymnasium (done on ``import
+    robostrich_suite`` when gymnasium is installed); returns the ids."""
+    ids = []
+    for domain, task in robostrich_suite.ALL_TASKS:
+        env_id = f"{domain}/{task}-v0"
+        if env_id not in gymnasium.registry:
+            gymnasium.register(id=env_id, entry_point="robostrich_suite.gym_adapter:make",
+                               kwargs=dict(domain_name=domain, task_name=task))
+        ids.append(env_id)
+    return ids

@@ -71,3 +71,62 @@ def test_step_after_the_episode_ended_asks_for_a_reset():
     assert truncated
     with pytest.raises(gymnasium.error.ResetNeeded, match="reset"):
         env.step(np.zeros(9, np.float32))
+
+
+def test_rgb_array_render_shows_the_arm_and_check_env_renders():
+    """render_mode='rgb_array' (issue 11: the adapter could not render); a real frame under EGL."""
+    import os
+    if os.environ.get("MUJOCO_GL") != "egl":
+        pytest.skip("renders under MUJOCO_GL=egl")
+    env = gym_adapter.make("robostrich", "lesson1", seed=0, time_limit=0.6, render_mode="rgb_array",
+                           width=160, height=120)
+    assert env.metadata["render_fps"] == 125
+    check_env(env)  # including gymnasium's render check
+    env.reset(seed=0)
+    straight = env.render()
+    assert straight.shape == (120, 160, 3) and straight.dtype == np.uint8
+    assert straight.std() > 5  # not a blank image
+    for _ in range(60):  # pull the ventral tendons: the neck bends, the picture changes
+        env.step(np.r_[-1.0, np.ones(8)].astype(np.float32))
+    bent = env.render()
+    assert np.abs(bent.astype(int) - straight.astype(int)).mean() > 0.5
+    assert gym_adapter.make("robostrich", "lesson1").render() is None  # no render mode: gymnasium's warning, None
+    with pytest.raises(ValueError, match="render_mode"):
+        gym_adapter.make("robostrich", "lesson1", render_mode="human")
+
+
+def test_every_task_is_registered_with_gymnasium():
+    import gymnasium
+    import robostrich_suite
+    ids = [f"{domain}/{task}-v0" for domain, task in robostrich_suite.ALL_TASKS]
+    assert "robostrich/lesson2-v0" in ids and "robostrich_a1/head_stabilize-v0" in ids
+    assert all(env_id in gymnasium.registry for env_id in ids)
+    env = gymnasium.make("robostrich/lesson2-v0", time_limit=0.08, position_tolerance=0.02)
+    obs, _ = env.reset(seed=1)
+    assert obs.shape == env.observation_space.shape
+    assert env.unwrapped.dm_env.task.position_tolerance == 0.02  # keyword arguments reach the task
+    steps, truncated = 0, False
+    while not truncated:
+        *_, truncated, _ = env.step(env.action_space.sample())
+        steps += 1
+    assert steps == 10
+
+
+def test_osmesa_without_its_library_is_a_clear_import_error():
+    """MUJOCO_GL=osmesa failed deep in PyOpenGL ('NoneType' object has no attribute 'glGetError');
+    it names the backend and the library to install, or renders where OSMesa is installed."""
+    import ctypes.util
+    import os
+    import subprocess
+    import sys
+    code = ("from robostrich_suite import gym_adapter; "
+            "env = gym_adapter.make('robostrich', 'lesson1', render_mode='rgb_array', width=64, height=48); "
+            "env.reset(seed=0); print(env.render().shape)")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                            env={**os.environ, "MUJOCO_GL": "osmesa"})
+    if ctypes.util.find_library("OSMesa"):
+        assert result.returncode == 0 and "(48, 64, 3)" in result.stdout, result.stderr[-2000:]
+    else:
+        last = result.stderr.strip().splitlines()[-1]
+        assert result.returncode != 0 and last.startswith("ImportError: "), result.stderr[-2000:]
+        assert "MUJOCO_GL='osmesa'" in last and "libosmesa6" in last and "MUJOCO_GL=egl" in last
