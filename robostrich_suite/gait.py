@@ -38,6 +38,7 @@ import csv
 import dataclasses
 import io
 import math
+import os
 import pathlib
 
 import numpy as np
@@ -291,6 +292,10 @@ def validate(times: np.ndarray, targets: np.ndarray, rows=None) -> None:
 
 def read_gait_file(path) -> tuple[np.ndarray, np.ndarray]:
     """Read and validate a gait CSV (module doc); returns ``(times, targets)``."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"a gait must be a gait file path (str or os.PathLike), a TrotGait, a GaitReplay "
+                        f"or an object with joint_targets(t, trunk_height, stride_scale); "
+                        f"got {type(path).__name__} {path!r}")
     path = pathlib.Path(path)
     rows, values = [], []
     header_seen = False

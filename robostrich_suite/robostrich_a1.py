@@ -348,6 +348,9 @@ class _QuadrupedTaskMixin:
             if gait is None:
                 gait = gait_lib.GaitReplay.from_file()
             elif not hasattr(gait, "joint_targets"):
+        elif gait is not None:
+            raise ValueError("gait applies to the walking tasks (lesson4, head_stabilize, narrow_gap); "
+                             "this task's quadruped stands")
                 gait = gait_lib.GaitReplay.from_file(gait)
         else:
             gait = gait_lib.Standing()

@@ -200,3 +200,19 @@ def test_gait_file_needs_its_header_and_tolerates_a_byte_order_mark(tmp_path):
 def test_trunk_height_schedule_rejects_nan_times():
     with pytest.raises(ValueError, match="finite"):
         gait.TrunkHeightSchedule(times=(0.0, float("nan")), heights=(0.27, 0.25))
+
+
+def test_gait_option_takes_a_path_or_a_gait_object_and_names_anything_else(tmp_path):
+    """What README says `gait=` accepts (issue 11); a standing task refuses a gait instead of ignoring it."""
+    import robostrich_suite
+    path = tmp_path / "trot.csv"
+    gait.write_gait_file(path, *gait.sample_trot())
+    for accepted in (str(path), path, gait.TrotGait(), gait.GaitReplay.from_file(path)):
+        env = robostrich_suite.load("robostrich_a1", "lesson4", task_kwargs=dict(gait=accepted, time_limit=0.016))
+        env.reset()
+        env.step(np.zeros(9))
+        assert hasattr(env.task.gait, "joint_targets")
+    with pytest.raises(TypeError, match="a gait must be a gait file path.*got int 42"):
+        robostrich_suite.load("robostrich_a1", "lesson4", task_kwargs=dict(gait=42))
+    with pytest.raises(ValueError, match="gait applies to the walking tasks"):
+        robostrich_suite.load("robostrich_a1", "lesson1", task_kwargs=dict(gait=gait.TrotGait()))
