@@ -43,3 +43,37 @@ def run(main: Callable, prog: str, argv: Optional[Sequence[str]] = None) -> int:
         print(f"{prog}: error: {error_message(error)}", file=sys.stderr)
         return USER_ERROR
     return 0
+
+
+def _number(kind, text: str):
+    import argparse
+    try:
+        return kind(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid {'whole number' if kind is int else 'number'}: {text!r}") from None
+
+
+def whole_number(minimum: int):
+    """argparse type: an int >= minimum (a usage error naming the flag otherwise)."""
+    import argparse
+
+    def parse(text: str) -> int:
+        value = _number(int, text)
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be at least {minimum}, got {text}")
+        return value
+    return parse
+
+
+def seconds(allow_zero: bool = False):
+    """argparse type: a finite number of seconds, > 0 (or >= 0 with allow_zero); NaN is refused."""
+    import argparse
+    import math
+
+    def parse(text: str) -> float:
+        value = _number(float, text)
+        if not math.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
+            raise argparse.ArgumentTypeError(
+                f"must be a finite number of seconds {'>= 0' if allow_zero else '> 0'}, got {text}")
+        return value
+    return parse

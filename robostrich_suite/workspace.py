@@ -25,6 +25,7 @@ import numpy as np
 from dm_control import mjcf
 
 from robostrich_suite import arm as arm_lib
+from robostrich_suite import cli as cli_lib
 
 LEVEL_ATTITUDE_DEG = 90.0
 LEVEL_TOLERANCE_DEG = 5.0
@@ -353,25 +354,27 @@ def main(argv=None) -> dict:
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/workspace"),
                         help="output directory (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
-    parser.add_argument("--samples", type=int, default=200_000,
+    parser.add_argument("--samples", type=cli_lib.whole_number(0), default=200_000,
                         help="kinematic samples: uniform joint angles (default: %(default)s)")
-    parser.add_argument("--edge-samples", type=int, default=100_000,
+    parser.add_argument("--edge-samples", type=cli_lib.whole_number(0), default=100_000,
                         help="extra kinematic samples with every joint near a common fraction of "
                              "its range, to fill the region's edges (default: %(default)s)")
-    parser.add_argument("--actuated-samples", type=int, default=600,
+    parser.add_argument("--actuated-samples", type=cli_lib.whole_number(0), default=600,
                         help="actuated samples: random held tendon inputs, 0 to skip "
                              "(default: %(default)s)")
-    parser.add_argument("--settle-time", type=float, default=1.5,
+    parser.add_argument("--settle-time", type=cli_lib.seconds(), default=1.5,
                         help="seconds each tendon input is held before the pose is recorded "
                              "(default: %(default)s)")
-    parser.add_argument("--seek-level", type=float, default=0.0, metavar="SECONDS",
+    parser.add_argument("--seek-level", type=cli_lib.seconds(allow_zero=True), default=0.0, metavar="SECONDS",
                         help="tune each draw's dorsal input for a level head for this long "
                              "before holding it (about 12 times more level poses for 2.7 "
                              "times the time; default: %(default)s = off)")
-    parser.add_argument("--workers", type=int, default=2,
+    parser.add_argument("--workers", type=cli_lib.whole_number(1), default=2,
                         help="processes for the actuated sampling (default: %(default)s)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     args = parser.parse_args(argv)
+    if args.samples + args.edge_samples == 0:
+        parser.error("argument --samples: --samples and --edge-samples are both 0: no kinematic workspace to draw")
 
     start = time.perf_counter()
     physics = frame_physics()

@@ -117,3 +117,22 @@ def test_targets_are_generated_from_the_workspace_sampler(tmp_path):
     with np.load(path) as data:
         assert len(data["head_position"]) == count
         assert np.all(np.abs(arm.attitude_error_deg(data["head_attitude"], 90)) <= 5)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--samples", "-5"], "argument --samples: must be at least 0, got -5"),
+    (["--samples", "0", "--edge-samples", "0"], "no kinematic workspace"),
+    (["--settle-time", "nan"], "argument --settle-time: must be a finite number of seconds > 0"),
+    (["--settle-time", "0"], "argument --settle-time: must be a finite number of seconds > 0"),
+    (["--seek-level", "-1"], "argument --seek-level: must be a finite number of seconds >= 0"),
+    (["--workers", "0"], "argument --workers: must be at least 1, got 0"),
+    (["--actuated-samples", "2.5"], "argument --actuated-samples: invalid whole number: '2.5'"),
+])
+def test_command_line_refuses_bad_numbers_by_flag(tmp_path, capsys, args, message):
+    """Before, these failed deep inside numpy ('negative dimensions are not allowed', 'cannot convert
+    float NaN to integer', a zero-size reduction) or ran with a silent fallback (--workers 0)."""
+    with pytest.raises(SystemExit) as exit_info:
+        workspace.main(["--out", str(tmp_path / "ws"), "--no-progress", *args])
+    assert exit_info.value.code == 2
+    assert message in capsys.readouterr().err.strip().splitlines()[-1]
+    assert not (tmp_path / "ws").exists()
