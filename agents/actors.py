@@ -4,7 +4,6 @@ The policy network works in [-1, 1]^|A|; `ActionAdapter` maps that box onto
 the BoundedArray spec (e.g. tendon contractions in metres) and back.
 """
 import jax
-import jax.numpy as jnp
 import numpy as np
 
 from agents.sac.networks import SACNetworks
@@ -64,44 +63,6 @@ class ResidualAdapter(ActionAdapter):
         raise NotImplementedError("a residual action depends on the observation; there is no fixed inverse")
 
 
-class IncrementalAdapter(ActionAdapter):
-    """The policy moves the tendon inputs by at most ``step`` (a fraction of each half-range) per decision.
-
-    Why: the arm's final pose is very sensitive to the inputs (a constant 1 cm change moves the
-    head by up to 10 cm, docs/learning.md), so an absolute input must be right to about a
-    millimetre, which a network's output rarely is. Changing the input instead gives the loop
-    integral action: the inputs come to rest wherever the policy outputs zero change, which a
-    feedback policy puts at zero error. Exploration becomes a random walk of the inputs, which
-    the slow arm feels, instead of white noise it filters out. The current command is read from
-    the observation's ``tendon_command`` (on [-1, 1] of the range), so the state stays Markov.
-    """
-
-    def __init__(self, action_spec, flattener, step: float):
-        super().__init__(action_spec)
-        if not (np.isfinite(step) and 0.0 < step <= 2.0):
-            raise ValueError(f"action increment must be in (0, 2] (a fraction of the half-range), got {step}")
-        keys = flattener.keys or ()
-        if "tendon_command" not in keys:
-            raise ValueError("incremental actions need a 'tendon_command' observation (the commanded inputs); "
-                             f"this environment has {list(keys) or 'none'}")
-        i = keys.index("tendon_command")
-        if flattener.sizes[i] != self.size:
-            raise ValueError(f"tendon_command has {flattener.sizes[i]} values, the action {self.size}")
-        start = int(sum(flattener.sizes[:i]))
-        self._command = slice(start, start + self.size)
-        self.step = float(step)
-
-    def to_env(self, policy_action, flat_obs=None) -> np.ndarray:
-        if flat_obs is None:
-            raise ValueError("an incremental policy needs the observation to know the current inputs")
-        command = np.asarray(flat_obs, np.float64)[self._command]
-        command = np.clip(command + self.step * np.asarray(policy_action, np.float64), -1.0, 1.0)
-        return super().to_env(command)
-
-    def to_policy(self, env_action) -> np.ndarray:
-        raise NotImplementedError("an incremental action depends on the observation; there is no fixed inverse")
-
-
 class Actor:
     """Runs the policy for one observation per call.
 
@@ -110,31 +71,16 @@ class Actor:
     carried inside the jitted call, so a step costs one dispatch.
     """
 
-    def __init__(self, networks: SACNetworks, adapter: ActionAdapter, params, key=None, deterministic=False,
-                 noise_correlation: float = 0.0):
-        """``noise_correlation`` rho in [0, 1): the exploration noise is an AR(1) process
-        eps_t = rho eps_{t-1} + sqrt(1 - rho^2) xi_t, still N(0, 1) at every step (so the policy
-        and its log-probability are unchanged) but correlated over about 1 / (1 - rho) decisions:
-        a slow arm filters white noise out and explores little (colored-noise exploration,
-        Eberhard et al. 2023). 0 = white noise, SAC as published."""
-        if not 0.0 <= noise_correlation < 1.0:
-            raise ValueError(f"noise_correlation must be in [0, 1), got {noise_correlation}")
+    def __init__(self, networks: SACNetworks, adapter: ActionAdapter, params, key=None, deterministic=False):
         self.adapter = adapter
         self.params = params
         self.deterministic = deterministic
         self.key = jax.random.PRNGKey(0) if key is None else key
-        self.noise = np.zeros(adapter.size, np.float32)  # the AR(1) state (unused when white)
-        rho = float(noise_correlation)
-        innovation = float(np.sqrt(1.0 - rho ** 2))
 
-        def stochastic(params, obs, key, noise):
+        def stochastic(params, obs, key):
             key, sample_key = jax.random.split(key)
-            if rho == 0.0:
-                action, _ = networks.sample(params, obs[None], sample_key)
-                return action[0], key, noise
-            noise = rho * noise + innovation * jax.random.normal(sample_key, noise.shape, noise.dtype)
-            mean, log_std = networks.policy_apply(params, obs[None])
-            return jnp.tanh(mean[0] + jnp.exp(log_std[0]) * noise), key, noise
+            action, _ = networks.sample(params, obs[None], sample_key)
+            return action[0], key
 
         def mode(params, obs):
             return networks.mode(params, obs[None])[0]
@@ -150,7 +96,7 @@ class Actor:
         if self.deterministic:
             action = self._mode(self.params, flat_obs)
         else:
-            action, self.key, self.noise = self._stochastic(self.params, flat_obs, self.key, self.noise)
+            action, self.key = self._stochastic(self.params, flat_obs, self.key)
         action = np.asarray(action)
         if not np.all(np.isfinite(action)):
             raise ValueError(f"policy produced a non-finite action {action}; observation was {flat_obs}")

@@ -131,7 +131,6 @@ class CurriculumRun:
         return {
             "learner": loop.learner.get_state(),
             "actor_key": np.asarray(loop.actor.key),
-            "actor_noise": np.asarray(loop.actor.noise),
             "replay": loop.replay.state_dict(),
             "loop": loop.state_dict(),
             "lesson_index": self.lesson_index,
@@ -150,7 +149,6 @@ class CurriculumRun:
         loop.learner.set_state(state["learner"])
         loop.actor.update(loop.learner.policy_params)
         loop.actor.key = np.asarray(state["actor_key"])
-        loop.actor.noise = np.asarray(state.get("actor_noise", np.zeros_like(loop.actor.noise)), np.float32)
         loop.replay.load_state_dict(state["replay"])
         self.lesson_index, self.lesson_steps = state["lesson_index"], state["lesson_steps"]
         if state["environment"] is not None:

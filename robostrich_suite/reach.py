@@ -79,14 +79,6 @@ def check_action(action: np.ndarray, control_range: np.ndarray) -> np.ndarray:
     return np.clip(action, low, high)
 
 
-def normalized_command(physics) -> np.ndarray:
-    """The tendon inputs now commanded, mapped onto [-1, 1] of their control range (an agent
-    that changes the inputs step by step needs to see where they are: a slack tendon's
-    contraction does not show it)."""
-    low, high = physics.arm_control_range().T
-    return (physics.arm_control() - 0.5 * (high + low)) / (0.5 * (high - low))
-
-
 class Reach(base.Task):
     """Bring the head to a target position (and, from lesson 2, hold it level)."""
 
@@ -220,7 +212,7 @@ class Reach(base.Task):
 
     # --- dm_control Task API ------------------------------------------------
     def get_observation(self, physics):
-        """Table 2 (head position, head velocity, joint angles) + goal + tendon state and command.
+        """Table 2 (head position, head velocity, joint angles) + goal + tendon state.
 
         Units are chosen so that every entry is of order one: metres, m/s,
         radians, and tendon forces as a fraction of the actuator's limit.
@@ -240,7 +232,6 @@ class Reach(base.Task):
         obs["head_attitude"] = np.array([np.radians(physics.head_attitude())])
         obs["tendon_contraction"] = physics.tendon_contractions()
         obs["tendon_tension"] = physics.tendon_forces() / physics.tendon_max_forces()
-        obs["tendon_command"] = normalized_command(physics)
         return obs
 
     def get_reward(self, physics):

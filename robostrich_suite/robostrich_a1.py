@@ -31,8 +31,7 @@ Observations (Table 2, then the goal and tendon state as in ``robostrich``):
 ``head_position`` (3), ``head_velocity`` (3), ``joint_angles`` (18),
 ``trunk_position`` (3: x, y walked since the episode start, height above ground),
 ``trunk_velocity`` (3, trunk frame), ``target_position`` (2), ``to_target`` (2),
-``attitude_error``, ``head_attitude``, ``tendon_contraction`` (9), ``tendon_tension`` (9),
-``tendon_command`` (9, the commanded inputs on [-1, 1] of their range).
+``attitude_error``, ``head_attitude``, ``tendon_contraction`` (9), ``tendon_tension`` (9).
 The action is the 9 tendon contractions; the legs follow the gait, not the policy.
 
 Timing: control step 0.008 s (the paper's) = 4 physics steps of 0.002 s; the
@@ -348,10 +347,10 @@ class _QuadrupedTaskMixin:
             if gait is None:
                 gait = gait_lib.GaitReplay.from_file()
             elif not hasattr(gait, "joint_targets"):
+                gait = gait_lib.GaitReplay.from_file(gait)
         elif gait is not None:
             raise ValueError("gait applies to the walking tasks (lesson4, head_stabilize, narrow_gap); "
                              "this task's quadruped stands")
-                gait = gait_lib.GaitReplay.from_file(gait)
         else:
             gait = gait_lib.Standing()
         self.legs = legs

@@ -106,26 +106,20 @@ def test_actor_stays_in_bounds_and_rejects_nan():
         actor.select_action(np.full(OBS, np.nan, np.float32))
 
 
-def test_correlated_exploration_noise_keeps_the_marginal_and_correlates_in_time():
-    """AR(1) noise: consecutive exploration offsets are correlated by rho, each still ~N(0, 1) around
-    the policy mean, so the policy's log-probability (used by the losses) is unchanged."""
-    spec = specs.BoundedArray((ACT,), np.float64, minimum=-1.0, maximum=1.0)
-    learner = make_learner()
-    obs = np.full(OBS, 0.1, np.float32)
-    mean, log_std = learner.networks.policy_apply(learner.policy_params, obs[None])
-    offsets = {}
-    for rho in (0.0, 0.95):
-        actor = Actor(learner.networks, ActionAdapter(spec), learner.policy_params, key=jax.random.PRNGKey(3),
-                      noise_correlation=rho)
-        u = np.arctanh(np.clip([actor.policy_action(obs) for _ in range(2000)], -0.999999, 0.999999))
-        offsets[rho] = (u - np.asarray(mean[0])) / np.exp(np.asarray(log_std[0]))
-    for rho, eps in offsets.items():
-        eps = eps[200:]  # the AR(1) state starts at 0
-        assert abs(eps.std() - 1.0) < 0.2, (rho, eps.std())
-        lag1 = np.mean([np.corrcoef(eps[:-1, j], eps[1:, j])[0, 1] for j in range(ACT)])
-        assert abs(lag1 - rho) < 0.07, (rho, lag1)
-    with pytest.raises(ValueError, match="noise_correlation"):
-        Actor(learner.networks, ActionAdapter(spec), learner.policy_params, noise_correlation=1.0)
+def test_action_anchor_keeps_the_deterministic_action_near_zero():
+    """A residual policy's anchor: on the same batches, a weighted penalty on the squared
+    deterministic action keeps it far closer to 0 (the base controller) than plain SAC's actor."""
+    import dataclasses
+    obs = random_batch(1, 256, seed=9).obs[0]
+    magnitude = {}
+    for weight in (0.0, 5.0):
+        learner = make_learner(config=dataclasses.replace(TINY, action_anchor=weight))
+        for i in range(40):
+            learner.step(random_batch(4, 32, seed=i))
+        magnitude[weight] = float(np.mean(np.abs(learner.networks.mode(learner.policy_params, obs))))
+    assert magnitude[5.0] < 0.5 * magnitude[0.0], magnitude
+    with pytest.raises(ValueError, match="action_anchor"):
+        SACConfig(action_anchor=-1.0)
 
 
 def test_replay_flattens_dict_observations_and_wraps():

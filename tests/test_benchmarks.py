@@ -150,3 +150,18 @@ def test_benchmark_dmc_rejects_unknown_settings_in_one_line():
     args = tool.build_parser().parse_args(["--eval-at", "100000,200000"])
     assert tool.task_settings(args, "cartpole/swingup") == (100_000, 8, [100_000])
     assert tool.task_settings(args, "reacher/easy") == (200_000, 4, [100_000, 200_000])
+
+
+def test_input_sensitivity_stored_inputs_hold_their_targets_and_errors_cost_success(tmp_path, tool_env):
+    """The stored input of a training target, held exactly, lands on it; a 30 % constant error does not."""
+    run_tool("input_sensitivity", "--errors", "0,0.3", "--every", "40", "--draws", "1", "--out", str(tmp_path / "s"),
+             cwd=tmp_path, env=tool_env)
+    rows = json.load(open(tmp_path / "s" / "sensitivity.json"))
+    assert [r["error_fraction"] for r in rows] == [0.0, 0.3]
+    exact, off = rows
+    assert exact["success_rate"] == 1.0 and exact["position_error_median"] < 0.01
+    assert off["success_rate"] < 1.0 and off["position_error_median"] > exact["position_error_median"]
+    assert "| 30 % |" in open(tmp_path / "s" / "sensitivity.md").read()
+    bad = subprocess.run([sys.executable, os.path.join(TOOLS, "input_sensitivity.py"), "--errors", "2"],
+                         capture_output=True, text=True, env=tool_env, cwd=tmp_path)
+    assert bad.returncode == 2 and "fractions in [0, 1]" in bad.stderr.strip().splitlines()[-1]

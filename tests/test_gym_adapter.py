@@ -14,7 +14,7 @@ def test_passes_gymnasiums_checker():
 def test_episode_ends_truncated_and_observation_matches_dm_env():
     env = gym_adapter.make("robostrich", "lesson2", seed=0, time_limit=0.08)
     obs, _ = env.reset(seed=3)
-    assert obs.shape == env.observation_space.shape == (55,)
+    assert obs.shape == env.observation_space.shape == (46,)
     joints = env.observation_slices["joint_angles"]
     np.testing.assert_array_equal(obs[joints], np.zeros(18, np.float32))
     steps, done = 0, False

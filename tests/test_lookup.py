@@ -137,33 +137,13 @@ def test_untrained_residual_agent_is_the_lookup(flattener, tmp_path):
     assert np.abs(SACBuilder.make_eval_actor(run.loop).policy_action(obs)).max() > 0
 
 
-def test_incremental_adapter_moves_the_commanded_inputs_step_by_step(flattener):
-    from agents.actors import IncrementalAdapter
-    env = make_environment("robostrich", "lesson2", 0)
-    spec = env.action_spec()
-    adapter = IncrementalAdapter(spec, flattener, step=0.05)
-    env.reset()
-    held = 0.5 * (spec.minimum + spec.maximum) + 0.3 * (spec.maximum - spec.minimum) * np.linspace(-1, 1, 9)
-    obs = flattener(env.step(held).observation)
-    np.testing.assert_allclose(adapter.to_env(np.zeros(9), obs), held, atol=1e-6)  # no change: the command stays
-    half = 0.5 * (spec.maximum - spec.minimum)
-    np.testing.assert_allclose(adapter.to_env(np.ones(9), obs), held + 0.05 * half, atol=1e-6)
-    np.testing.assert_allclose(adapter.to_env(np.full(9, -1.0), flattener(env.step(spec.minimum).observation)),
-                               spec.minimum, atol=1e-6)  # clipped at the bottom of the range
-    with pytest.raises(ValueError, match="tendon_command"):
-        IncrementalAdapter(spec, ObservationFlattener(collections.OrderedDict(
-            position=specs.Array((2,), np.float64))), step=0.05)
-
-
 def test_continued_episode_keeps_the_servo_command():
-    """Lesson 3 starts where the last episode ended, inputs included (an incremental agent
-    reads them from the observation; a real servo keeps its command)."""
+    """Lesson 3 starts where the last episode ended, inputs included (a real servo keeps its command)."""
     env = make_environment("robostrich", "lesson3", 0)
     spec = env.action_spec()
     held = spec.minimum + 0.6 * (spec.maximum - spec.minimum)
     timestep = env.reset()
     while not timestep.last():
         timestep = env.step(held)
-    first = env.reset().observation
+    env.reset()
     np.testing.assert_allclose(env.physics.arm_control(), held)
-    np.testing.assert_allclose(first["tendon_command"], np.full(9, 0.2), atol=1e-9)

@@ -52,7 +52,7 @@ def test_observation_layout_matches_table2():
     assert shapes[:5] == [(k, (n,)) for k, n in TABLE2.items()]
     assert shapes[5:] == [("target_position", (2,)), ("to_target", (2,)),
                           ("attitude_error", (1,)), ("head_attitude", (1,)),
-                          ("tendon_contraction", (9,)), ("tendon_tension", (9,)), ("tendon_command", (9,))]
+                          ("tendon_contraction", (9,)), ("tendon_tension", (9,))]
     assert sum(TABLE2.values()) == 30
 
 

@@ -56,7 +56,7 @@ def test_observation_names_and_sizes():
     assert shapes == {"head_position": (2,), "head_velocity": (2,), "joint_angles": (18,),
                       "target_position": (2,), "to_target": (2,), "attitude_error": (1,),
                       "head_attitude": (1,), "tendon_contraction": (9,),
-                      "tendon_tension": (9,), "tendon_command": (9,)}
+                      "tendon_tension": (9,)}
 
 
 def _pose_env(task_name, target):

@@ -1,7 +1,7 @@
 """Wires networks, learner, replay, actor and loop for one environment's specs."""
 import jax
 
-from agents.actors import ActionAdapter, Actor, IncrementalAdapter, ResidualAdapter
+from agents.actors import ActionAdapter, Actor, ResidualAdapter
 from agents.goals import GoalRelabeler
 from agents.loop import EnvironmentLoop
 from agents.replay import ObservationFlattener, ReplayBuffer
@@ -29,8 +29,6 @@ class SACBuilder:
         if cfg.residual_scale > 0:
             from agents.lookup import LookupPolicy
             adapter = ResidualAdapter(action_spec, LookupPolicy(flattener), cfg.residual_scale)
-        elif cfg.action_increment > 0:
-            adapter = IncrementalAdapter(action_spec, flattener, cfg.action_increment)
         else:
             adapter = ActionAdapter(action_spec)
         networks = make_networks(flattener.size, adapter.size, cfg.hidden_sizes, cfg.log_std_min, cfg.log_std_max,
@@ -42,8 +40,7 @@ class SACBuilder:
         goal_width = relabeler.goal_size + 1 if relabeler is not None else 0  # + attitude error
         replay = ReplayBuffer(flattener.size, adapter.size, cfg.max_replay_size, seed=seed,
                               goal_width=goal_width, repeat=cfg.action_repeat)
-        actor = Actor(networks, adapter, learner.policy_params, key=actor_key, deterministic=False,
-                      noise_correlation=cfg.noise_correlation)
+        actor = Actor(networks, adapter, learner.policy_params, key=actor_key, deterministic=False)
         loop = EnvironmentLoop(env, actor, replay, learner, cfg, flattener, seed=seed)
         return loop
 

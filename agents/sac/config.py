@@ -52,16 +52,10 @@ class SACConfig:
     # observation: the action is the lookup's stored input plus this fraction of each tendon's
     # half-range times the policy's output (0 = off: the policy outputs the whole input).
     residual_scale: float = 0.0
-    # Incremental actions on tasks with a tendon_command observation: the policy changes each
-    # input by at most this fraction of its half-range per decision (0 = off: absolute inputs).
-    action_increment: float = 0.0
     # Weight of a penalty on the squared deterministic action in the actor loss (times the
     # critic's mean |Q|, as TD3+BC): keeps a residual policy at its base unless the critic
     # clearly prefers a correction (0 = off, plain SAC's actor loss; 0.4 is TD3+BC's alpha = 2.5).
     action_anchor: float = 0.0
-    # Exploration noise correlated over time (AR(1) coefficient per decision, agents/actors.py):
-    # 0 = white noise as published; 0.97 at one decision per 8 ms is correlated over ~0.25 s.
-    noise_correlation: float = 0.0
 
     def __post_init__(self):
         if min(self.batch_size, self.updates_per_call, self.env_steps_per_call, self.action_repeat) <= 0:
@@ -77,12 +71,6 @@ class SACConfig:
                              "base action, so the stored residual would no longer mean what it did")
         if not (np.isfinite(self.action_anchor) and self.action_anchor >= 0):
             raise ValueError(f"action_anchor must be a finite weight >= 0, got {self.action_anchor}")
-        if not 0.0 <= self.noise_correlation < 1.0:
-            raise ValueError(f"noise_correlation must be in [0, 1), got {self.noise_correlation}")
-        if not 0.0 <= self.action_increment <= 2.0:
-            raise ValueError(f"action_increment must be in [0, 2] (0 = absolute inputs), got {self.action_increment}")
-        if self.action_increment > 0 and self.residual_scale > 0:
-            raise ValueError("action_increment and residual_scale are two different action spaces; choose one")
         if self.min_replay_size > self.max_replay_size:
             raise ValueError("min_replay_size exceeds max_replay_size")
         object.__setattr__(self, "hidden_sizes", tuple(int(h) for h in self.hidden_sizes))
@@ -108,8 +96,8 @@ class SACConfig:
                       init_temperature=1.0, hidden_sizes=(256, 256), min_replay_size=10_000,
                       max_replay_size=1_000_000, updates_per_call=8, env_steps_per_call=8, action_repeat=1,
                       reward_scale=1.0, critic_layer_norm=False, her_ratio=0.0, relabel_rewards=False,
-                      residual_scale=0.0, action_increment=0.0,
-                      action_anchor=0.0, noise_correlation=0.0)
+                      residual_scale=0.0,
+                      action_anchor=0.0)
         values.update(overrides)
         return cls(**values)
 
