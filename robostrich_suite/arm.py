@@ -427,6 +427,41 @@ def build_frame_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = N
 HEAD_SITE_PATH = f"{ARM_MODEL_NAME}/{HEAD_SITE}"
 
 
+def tendon_sides(model) -> list[str]:
+    """The side (one of ``SIDES``) of each of the arm's tendons, in action order.
+
+    Read from the model: a tendon runs through the holes of its ``TendonSpec.side``
+    (``build_arm`` names them so), so its last hole says its side whatever its name.
+    ``model`` is a physics' model with an attached arm (other actuators are skipped).
+    """
+    prefix = ARM_MODEL_NAME + "/"
+    hole_suffixes = {side: _hole_site_name("", side) for side in SIDES}
+    sides = []
+    for i in range(model.nu):
+        if not model.id2name(i, "actuator").startswith(prefix):
+            continue
+        tendon = model.actuator_trnid[i, 0]
+        last_site = model.wrap_objid[model.tendon_adr[tendon] + model.tendon_num[tendon] - 1]
+        name = model.id2name(int(last_site), "site")
+        sides.append(next(side for side, suffix in hole_suffixes.items()
+                          if name.endswith(suffix)))
+    return sides
+
+
+def dorsal_index(model) -> int:
+    """Action index of the arm's dorsal tendon: the first one on the dorsal side (every
+    layout lists the paper's dorsal tendon, the one to the head, first)."""
+    sides = tendon_sides(model)
+    if "dorsal" not in sides:
+        raise ValueError("the arm has no dorsal tendon")
+    return sides.index("dorsal")
+
+
+def ventral_indices(model) -> list[int]:
+    """Action indices of the arm's ventral tendons, in action order."""
+    return [i for i, side in enumerate(tendon_sides(model)) if side == "ventral"]
+
+
 def head_velocity(physics) -> np.ndarray:
     """World linear velocity (x, y, z) of the head site."""
     return np.array(physics.named.data.sensordata[f"{ARM_MODEL_NAME}/{HEAD_VELOCITY_SENSOR}"])

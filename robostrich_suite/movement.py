@@ -168,18 +168,6 @@ class MovementConfig:
 PAPER_LAYOUT = dict(ventral_span=None, dorsal_hold="length", release=False, ramp_time=1.0)
 
 
-def ventral_order(physics: mjcf.Physics) -> list[int]:
-    """Actuator indices of the ventral tendons in action order, which
-    ``TendonLayout.robostrich`` lists caudal insertion first."""
-    names = [physics.model.id2name(i, "actuator") for i in range(physics.model.nu)]
-    return [i for i, n in enumerate(names) if "ventral" in n]
-
-
-def dorsal_index(physics: mjcf.Physics) -> int:
-    names = [physics.model.id2name(i, "actuator") for i in range(physics.model.nu)]
-    return next(i for i, n in enumerate(names) if n.endswith("dorsal"))
-
-
 def servo_rest_lengths(model) -> np.ndarray:
     """Each tendon servo's length at zero input (the affine bias is kp * rest length);
     a tendon's contraction is this minus its current length."""
@@ -198,7 +186,7 @@ def ventral_amplitudes(config: MovementConfig, physics: mjcf.Physics) -> np.ndar
     """The contraction (m) each ventral tendon is ramped to: the configured amplitude,
     clipped to that tendon's input range (so most get less than asked)."""
     low, high = physics.model.actuator_ctrlrange.T
-    ventral = ventral_order(physics)
+    ventral = arm_lib.ventral_indices(physics.model)
     return np.clip(config.ventral_amplitude(), low[ventral], high[ventral])
 
 
@@ -208,8 +196,8 @@ def schedule(config: MovementConfig, physics: mjcf.Physics):
     Both patterns start from the same pose (dorsal at ``dorsal``, the most caudal
     ventral tendon at ``amplitude``) and ramp the others over the same total time.
     """
-    ventral = ventral_order(physics)
-    dorsal = dorsal_index(physics)
+    ventral = arm_lib.ventral_indices(physics.model)
+    dorsal = arm_lib.dorsal_index(physics.model)
     amplitude = ventral_amplitudes(config, physics)
     total = (len(ventral) - 1) * config.ramp_time
 
@@ -238,6 +226,7 @@ class Movement:
     """What one movement test did, one row per recorded frame."""
     config: MovementConfig
     tendon_names: list[str]
+    tendon_sides: list[str]  # arm.tendon_sides: "dorsal" or "ventral" per tendon
     time: np.ndarray  # (n,) s
     control: np.ndarray  # (n, nu) actuator inputs (m)
     contraction: np.ndarray  # (n, nu) measured tendon contractions (m)
@@ -298,9 +287,9 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
     """Simulate one movement test; log it to ``recording`` (a Rerun stream) if given."""
     spec = spec or arm_lib.ArmSpec.from_table1()
     physics = physics or workspace.frame_physics(spec, config.layout(spec))
-    ventral = ventral_order(physics)
+    ventral = arm_lib.ventral_indices(physics.model)
     config.validate(len(ventral))
-    dorsal = dorsal_index(physics)
+    dorsal = arm_lib.dorsal_index(physics.model)
     model = physics.model
     tendon_ids = model.actuator_trnid[:, 0]
     rest = servo_rest_lengths(model)
@@ -308,6 +297,7 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
     dt = model.opt.timestep
     steps = int(round(config.duration(len(ventral)) / dt))
     names = [model.id2name(i, "actuator").split("/")[-1] for i in range(model.nu)]
+    sides = arm_lib.tendon_sides(model)
 
     if recording is not None:
         from robostrich_suite import rerun_log
@@ -340,11 +330,11 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
             attitude = workspace.head_attitude_deg(physics)
             rows.append((t, x.copy(), contraction, head, attitude, _chain_points(physics, spec)))
             if recording is not None:
-                _log_frame(recording, physics, rows, names)
+                _log_frame(recording, physics, rows, names, sides)
         if k < steps:
             physics.step()
     time_, control, contraction, head, attitude, points = (np.array(c) for c in zip(*rows))
-    return Movement(config, names, time_, control, contraction, head, attitude, points,
+    return Movement(config, names, sides, time_, control, contraction, head, attitude, points,
                     ventral_amplitudes(config, physics))
 
 
@@ -376,17 +366,17 @@ def match_lever_amplitude(config: MovementConfig, travel: float,
     return 0.5 * (low + high)
 
 
-def _log_frame(recording, physics, rows, names) -> None:
+def _log_frame(recording, physics, rows, names, sides) -> None:
     """One frame: body poses, tendon paths, inputs, attitude and the head path so far."""
     from robostrich_suite import rerun_log
     t, control, contraction, head, attitude, _ = rows[-1]
     rerun_log.set_sim_time(recording, t)
     rerun_log.log_body_poses(recording, physics)
     model, data = physics.model, physics.data
-    for name, tendon in zip(names, model.actuator_trnid[:, 0]):
+    for name, side, tendon in zip(names, sides, model.actuator_trnid[:, 0]):
         start, count = data.ten_wrapadr[tendon], data.ten_wrapnum[tendon]
         points = data.wrap_xpos[start:start + count]
-        color = (220, 50, 50) if "dorsal" in name else (40, 110, 230)
+        color = (220, 50, 50) if side == "dorsal" else (40, 110, 230)
         rerun_log.log_path(recording, f"world/tendons/{name}", points, color=color)
     rerun_log.log_scalars(recording, "tendon_input", dict(zip(names, control)))
     rerun_log.log_scalars(recording, "tendon_contraction", dict(zip(names, contraction)))
@@ -432,7 +422,7 @@ def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int
     spec = spec or arm_lib.ArmSpec.from_table1()
     physics = workspace.frame_physics(spec, layout)
     model = physics.model
-    ventral, dorsal_id = ventral_order(physics), dorsal_index(physics)
+    ventral, dorsal_id = arm_lib.ventral_indices(physics.model), arm_lib.dorsal_index(physics.model)
     tendon_ids = model.actuator_trnid[:, 0]
     rest = servo_rest_lengths(model)
     high = model.actuator_ctrlrange[ventral, 1]
@@ -490,9 +480,10 @@ def _plot_inputs(ax, movement: Movement) -> None:
     import matplotlib.pyplot as plt
     colors = plt.cm.viridis(np.linspace(0, 0.95, len(movement.tendon_names)))
     for i, name in enumerate(movement.tendon_names):
-        style = dict(color="tab:red", lw=2.0) if "dorsal" in name else dict(color=colors[i])
+        style = (dict(color="tab:red", lw=2.0) if movement.tendon_sides[i] == "dorsal"
+                 else dict(color=colors[i]))
         ax.plot(movement.time, 1000 * movement.control[:, i], label=name, **style)
-    dorsal = movement.tendon_names.index("dorsal")
+    dorsal = movement.tendon_sides.index("dorsal")
     if movement.config.dorsal_hold == "length":
         ax.plot(movement.time, 1000 * movement.contraction[:, dorsal], "--", color="tab:red",
                 lw=1, label="dorsal, measured contraction")

@@ -21,14 +21,16 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import robostrich_suite  # noqa: E402
+from robostrich_suite import arm as arm_lib  # noqa: E402
 from robostrich_suite import gait as gait_lib  # noqa: E402
 from robostrich_suite import rerun_log  # noqa: E402
 from robostrich_suite.robostrich_a1 import CONTROL_TIMESTEP, SUITE  # noqa: E402
 
 
-def scripted_tendons(kind: str, control_range: np.ndarray):
+def scripted_tendons(kind: str, control_range: np.ndarray, dorsal: int):
     """Tendon input as a function of time: ``zero``, or ``sine`` (a slow nod: the ventral
-    tendons contract together at 0.5 Hz up to 30 % of their range, the dorsal one pays out)."""
+    tendons contract together at 0.5 Hz up to 30 % of their range, the dorsal one, action
+    index ``dorsal`` (:func:`arm.dorsal_index`), pays out)."""
     low, high = control_range.T
     if kind == "zero":
         return lambda t: np.zeros(len(low))
@@ -36,7 +38,7 @@ def scripted_tendons(kind: str, control_range: np.ndarray):
         def nod(t):
             level = 0.15 * (1 - np.cos(2 * np.pi * 0.5 * t))
             action = level * high
-            action[0] = level * low[0]
+            action[dorsal] = level * low[dorsal]
             return action
         return nod
     raise ValueError(f"unknown tendon script {kind!r}; use 'zero' or 'sine'")
@@ -58,7 +60,8 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
     env = robostrich_suite.load("robostrich_a1", task_name, task_kwargs=task_kwargs)
     env.reset()
     physics = env.physics
-    script = scripted_tendons(tendons, physics.arm_control_range())
+    script = scripted_tendons(tendons, physics.arm_control_range(),
+                              arm_lib.dorsal_index(physics.model))
     rec = None
     if rrd_path is not None:
         rec = rerun_log.recording("robostrich_a1_walk", pathlib.Path(rrd_path))

@@ -198,20 +198,22 @@ LEVEL_SEEK_GAIN = 1e-3  # m of dorsal input per degree of attitude error per sec
 
 
 def seek_level(physics: mjcf.Physics, control: np.ndarray, seek_time: float) -> np.ndarray:
-    """From reset, hold ``control`` but servo the dorsal input (index 0) on the head attitude
-    towards 90 deg for ``seek_time`` seconds; return the inputs with the final dorsal input.
+    """From reset, hold ``control`` but servo the dorsal input (:func:`arm.dorsal_index`) on
+    the head attitude towards 90 deg for ``seek_time`` seconds; return the inputs with the
+    final dorsal input.
 
     The result is only a candidate: :func:`settle` then holds it constant from reset, and
     only a pose that comes to rest level there counts."""
     control = np.array(control, dtype=float)
-    low, high = physics.model.actuator_ctrlrange[0]
+    dorsal = arm_lib.dorsal_index(physics.model)
+    low, high = physics.model.actuator_ctrlrange[dorsal]
     dt = physics.model.opt.timestep
     physics.reset()
     physics.data.ctrl[:] = control
     for _ in range(int(round(seek_time / dt))):
         error = float(arm_lib.attitude_error_deg(head_attitude_deg(physics), LEVEL_ATTITUDE_DEG))
-        control[0] = np.clip(control[0] + LEVEL_SEEK_GAIN * error * dt, low, high)
-        physics.data.ctrl[0] = control[0]
+        control[dorsal] = np.clip(control[dorsal] + LEVEL_SEEK_GAIN * error * dt, low, high)
+        physics.data.ctrl[dorsal] = control[dorsal]
         physics.step()
     return control
 

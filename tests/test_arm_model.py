@@ -210,3 +210,20 @@ def test_ventral_slips_layout():
     assert _tendon_joints(physics, "arm/ventral_c8") == {"c11", "c10", "c9", "c8"}
     with pytest.raises(ValueError, match="span must be a positive"):
         arm.TendonLayout.ventral_slips(spec, span=0)
+
+
+def test_tendon_sides_come_from_the_model_not_the_names():
+    """The dorsal tendon is found by its side wherever the layout lists it and whatever it
+    is called: here a ventral tendon named 'dorsal' comes first and the dorsal one third."""
+    spec = arm.ArmSpec.from_table1()
+    layout = arm.TendonLayout((
+        arm.TendonSpec.spanning("dorsal", "ventral", "c4", spec),
+        arm.TendonSpec.spanning("v2", "ventral", "c8", spec),
+        arm.TendonSpec.spanning("pull_back", "dorsal", spec.head_name, spec),
+    ))
+    model = mjcf.Physics.from_mjcf_model(arm.build_frame_arm(spec, layout)).model
+    assert arm.tendon_sides(model) == ["ventral", "ventral", "dorsal"]
+    assert arm.dorsal_index(model) == 2
+    assert arm.ventral_indices(model) == [0, 1]
+    default = Physics.from_xml_string(*get_model_and_assets()).model
+    assert arm.dorsal_index(default) == 0 and arm.ventral_indices(default) == list(range(1, 9))
