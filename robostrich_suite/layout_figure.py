@@ -7,6 +7,7 @@ import pathlib
 import numpy as np
 
 from robostrich_suite import arm as arm_lib
+from robostrich_suite import conventions
 from robostrich_suite import coverage as coverage_lib
 from robostrich_suite import workspace
 
@@ -107,7 +108,7 @@ def plot(cases, region: coverage_lib.BlueRegion, results, path) -> pathlib.Path:
         ax.tick_params(labelsize=7)
         _routing_panel(axes[1, column], case.spec, case.layout)
     axes[0, 0].set_ylabel("z (m, up)", fontsize=8)
-    level = f"{workspace.LEVEL_ATTITUDE_DEG:g}$\\pm${workspace.LEVEL_TOLERANCE_DEG:g}$^\\circ$"
+    level = f"{conventions.LEVEL_ATTITUDE_DEG:g}$\\pm${conventions.LEVEL_TOLERANCE_DEG:g}$^\\circ$"
     handles = [
         Line2D([], [], ls="", marker="o", ms=3, color="tab:blue", label=f"kinematic head, attitude {level} (blue region)"),
         Patch(facecolor="#a6dba0", edgecolor="#1b7837",

@@ -20,6 +20,7 @@ import mujoco
 import numpy as np
 
 from robostrich_suite import arm as arm_lib
+from robostrich_suite import conventions
 from robostrich_suite import movement, workspace
 from robostrich_suite.robostrich import DEFAULT_TIME_LIMIT
 
@@ -65,7 +66,7 @@ def seek_pose(physics, target_xz, control, seek_time: float = SEEK_TIME,
             error = np.array([target_xz[0] - data.site_xpos[site, 0],
                               target_xz[1] - data.site_xpos[site, 2],
                               ATTITUDE_SCALE * np.radians(float(arm_lib.attitude_error_deg(
-                                  workspace.LEVEL_ATTITUDE_DEG, attitude)))])
+                                  conventions.LEVEL_ATTITUDE_DEG, attitude)))])
             jacobian = np.stack([jacp[0], jacp[2], ATTITUDE_SCALE * jacr[1]])
             joint_step = jacobian.T @ np.linalg.solve(jacobian @ jacobian.T + DAMPING * np.eye(3), error)
             mujoco.mju_sparse2dense(tendon_jacobian, data.ten_J, model.ten_J_rownnz,

@@ -27,10 +27,9 @@ from dm_env import specs
 from robostrich_suite import arm as arm_lib
 from robostrich_suite import randomization as randomization_lib
 from robostrich_suite import rewards
-
-POSITION_TOLERANCE = 0.05  # m (paper Sec. 4.2)
-ATTITUDE_TOLERANCE = 5.0  # deg
-DESIRED_ATTITUDE = 90.0  # deg: head parallel to the ground
+from robostrich_suite.conventions import LEVEL_ATTITUDE_DEG as DESIRED_ATTITUDE
+from robostrich_suite.conventions import LEVEL_TOLERANCE_DEG as ATTITUDE_TOLERANCE
+from robostrich_suite.conventions import POSITION_TOLERANCE
 INITIAL_STATES = ("fixed", "continue")
 REWARDS = ("lesson1", "lesson2")
 

@@ -26,9 +26,7 @@ from dm_control import mjcf
 
 from robostrich_suite import arm as arm_lib
 from robostrich_suite import cli as cli_lib
-
-LEVEL_ATTITUDE_DEG = 90.0
-LEVEL_TOLERANCE_DEG = 5.0
+from robostrich_suite.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
 # Joint limits are soft constraints (arm.ArmSpec.limit_solref): a settled pose may
 # sit slightly past Table 1.  Measured over 1200 random tendon inputs: at most 0.8 deg.
 LIMIT_TOLERANCE_DEG = 1.0
@@ -295,7 +293,7 @@ def plot_workspace(kinematic: KinematicSamples, actuated: ActuatedSamples | None
     ax.scatter(*kinematic.head_position.T, s=1, c="tab:red", alpha=0.25, lw=0, rasterized=True,
                label=f"head positions ({len(level)} samples)")
     ax.scatter(*kinematic.head_position[level].T, s=3, c="tab:blue", lw=0, rasterized=True,
-               label=f"attitude 90$\\pm${LEVEL_TOLERANCE_DEG:.0f}$^\\circ$ ({level.sum()})")
+               label=f"attitude {LEVEL_ATTITUDE_DEG:.0f}$\\pm${LEVEL_TOLERANCE_DEG:.0f}$^\\circ$ ({level.sum()})")
     ax.set_title("(A) kinematic workspace (paper Fig. 6)")
     if actuated is not None:
         ax = axes[0, 1]
@@ -350,7 +348,8 @@ def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(
         prog="robostrich-workspace",
         description="Kinematic workspace of the Robostrich arm (paper Fig. 6: red = all head "
-                    "positions, blue = head level 90+-5 deg) and the actuated workspace (head "
+                    f"positions, blue = head level {LEVEL_ATTITUDE_DEG:g}+-{LEVEL_TOLERANCE_DEG:g} "
+                    "deg) and the actuated workspace (head "
                     "poses the tendons hold at rest under gravity). Writes workspace.png and "
                     "workspace_samples.npz.")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/workspace"),
@@ -394,7 +393,7 @@ def main(argv=None) -> dict:
     level = kinematic.level()
     print(f"kinematic: {len(level)} samples ({kinematic.uniform.sum()} uniform), "
           f"{level.sum()} with the head level ({(level & kinematic.uniform).sum()} uniform) "
-          f"(90+-{LEVEL_TOLERANCE_DEG:g} deg); x {np.ptp(kinematic.head_position[:, 0]):.3f} m by "
+          f"({LEVEL_ATTITUDE_DEG:g}+-{LEVEL_TOLERANCE_DEG:g} deg); x {np.ptp(kinematic.head_position[:, 0]):.3f} m by "
           f"z {np.ptp(kinematic.head_position[:, 1]):.3f} m")
     if actuated is not None:
         print(f"actuated: {actuated.settled.sum()} of {len(actuated.settled)} settled, "

@@ -1,0 +1,9 @@
+"""Conventions every task and study shares, each stated once here and imported.
+
+The level head (the tasks' desired attitude and the workspace's blue region) and
+the tasks' success tolerances (paper Sec. 4.2).
+"""
+
+LEVEL_ATTITUDE_DEG = 90.0  # deg: head parallel to the ground (paper Fig. 2B)
+LEVEL_TOLERANCE_DEG = 5.0  # deg: a head within this of level counts as level
+POSITION_TOLERANCE = 0.05  # m (paper Sec. 4.2)
