@@ -33,6 +33,7 @@ import numpy as np
 from dm_control import mjcf
 
 from robostrich_suite import table1
+from robostrich_suite.conventions import PHYSICS_TIMESTEP
 
 SIDES = ("dorsal", "ventral")
 ARM_MODEL_NAME = "arm"
@@ -301,7 +302,7 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
     model = mjcf.RootElement(model=ARM_MODEL_NAME)
     model.compiler.angle = "radian"
     model.option.integrator = "implicitfast"
-    model.option.timestep = 0.002
+    model.option.timestep = PHYSICS_TIMESTEP
     link_default = model.default.add("default", dclass="link")
     link_default.geom.set_attributes(type="capsule", size=[spec.link_radius],
                                      contype=COLLISION_TYPE, conaffinity=0,
@@ -396,8 +397,11 @@ def _add_tendon_servos(model: mjcf.RootElement, spec: ArmSpec, layout: TendonLay
             gainprm=[-kp], biasprm=[kp * rest_length, -kp, -kv])
 
 
+FRAME_HEIGHT = 0.05  # m, top of the immobile frame, where the arm's base sits
+
+
 def build_frame_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None,
-                    base_height: float = 0.05) -> mjcf.RootElement:
+                    base_height: float = FRAME_HEIGHT) -> mjcf.RootElement:
     """The arm on an immobile frame (the paper's first setup), neck pointing up.
 
     The frame's top carries the arm's base; the base link's joint is at
@@ -406,7 +410,7 @@ def build_frame_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = N
     spec = spec or ArmSpec.from_table1()
     arena = mjcf.RootElement(model="robostrich")
     arena.compiler.angle = "radian"
-    arena.option.timestep = 0.002
+    arena.option.timestep = PHYSICS_TIMESTEP
     arena.option.integrator = "implicitfast"
     arena.visual.headlight.set_attributes(ambient=[0.4, 0.4, 0.4], diffuse=[0.6, 0.6, 0.6])
     arena.asset.add("texture", name="grid", type="2d", builtin="checker", width=256, height=256,

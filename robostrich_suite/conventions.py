@@ -1,9 +1,12 @@
 """Conventions every task and study shares, each stated once here and imported.
 
-The level head (the tasks' desired attitude and the workspace's blue region) and
-the tasks' success tolerances (paper Sec. 4.2).
+The level head (the tasks' desired attitude and the workspace's blue region),
+the tasks' success tolerances and the timesteps (paper Sec. 4.2).
 """
 
 LEVEL_ATTITUDE_DEG = 90.0  # deg: head parallel to the ground (paper Fig. 2B)
 LEVEL_TOLERANCE_DEG = 5.0  # deg: a head within this of level counts as level
 POSITION_TOLERANCE = 0.05  # m (paper Sec. 4.2)
+
+CONTROL_TIMESTEP = 0.008  # s (paper Sec. 4.2)
+PHYSICS_TIMESTEP = 0.002  # s; 4 substeps per control step

@@ -110,13 +110,14 @@ from dm_control import mjcf
 
 from robostrich_suite import arm as arm_lib
 from robostrich_suite import workspace
+from robostrich_suite.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
 
 PATTERNS = ("rolling", "lever")
 SETTLE_TIME = 3.0  # s before the ventral ramps start: the start pose comes to rest
 RAMP_IN_TIME = 1.0  # s over which the start inputs are ramped in from the straight neck
 HOLD_TIME = 1.5  # s after the last ramp, to see the end pose at rest
 DORSAL_HOLD_GAIN = 30.0  # 1/s, integral gain of the dorsal length hold
-RECORD_EVERY = 4  # physics steps per recorded frame = the environments' 0.008 s
+RECORD_EVERY = int(round(CONTROL_TIMESTEP / PHYSICS_TIMESTEP))  # physics steps per frame: a control step
 
 
 @dataclasses.dataclass(frozen=True)

@@ -21,9 +21,7 @@ from dm_control.utils import containers
 
 from robostrich_suite import arm as arm_lib
 from robostrich_suite import arm_physics, reach
-
-CONTROL_TIMESTEP = 0.008  # s (paper Sec. 4.2)
-PHYSICS_TIMESTEP = 0.002  # s; 4 substeps per control step
+from robostrich_suite.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
 DEFAULT_TIME_LIMIT = 2.0  # s
 TRACK_STEPS_PER_TARGET = 250
 XML_PRECISION = 10  # significant digits in the generated MJCF (readable, and exact enough)

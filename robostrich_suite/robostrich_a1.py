@@ -63,9 +63,7 @@ from robostrich_suite import arm as arm_lib
 from robostrich_suite import arm_physics, reach
 from robostrich_suite import gait as gait_lib
 from robostrich_suite import quadruped as quad
-
-CONTROL_TIMESTEP = 0.008  # s (paper Sec. 4.2)
-PHYSICS_TIMESTEP = 0.002  # s; 4 substeps per control step
+from robostrich_suite.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
 SETTLE_TIME = 0.2  # s of standing physics before each fresh episode
 LESSON_TIME_LIMIT = 2.0  # s, lessons 1-3 (as in ``robostrich``)
 LESSON4_TIME_LIMIT = 6.0  # s: stand-in, lowered/raised, back (one height change)
@@ -92,7 +90,7 @@ TRUNK = quad.TRUNK_BODY
 # height it has when the quadruped stands at its nominal trunk height.
 MOUNT_OFFSET = np.array([quad.MOUNT_X, 0.0, quad.TRUNK_SIZE[2] / 2 + quad.ARM_BASE_CLEARANCE])
 NOMINAL_MOUNT_HEIGHT = quad.STANDING_TRUNK_HEIGHT + MOUNT_OFFSET[2]
-FRAME_MOUNT_HEIGHT = 0.05 + arm_lib.ArmSpec.from_table1().anchor_depth  # build_frame_arm's C18
+FRAME_MOUNT_HEIGHT = arm_lib.FRAME_HEIGHT + arm_lib.ArmSpec.from_table1().anchor_depth  # build_frame_arm's C18
 
 # head_stabilize (Sec. 5.2.1): P_d and the head height above ground.
 # A level-head pose of the actuated workspace (frame pose (0.31, 0.27) on the trunk).
