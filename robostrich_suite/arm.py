@@ -28,6 +28,7 @@ naming the offending item.
 from __future__ import annotations
 
 import dataclasses
+from typing import NamedTuple
 
 import numpy as np
 from dm_control import mjcf
@@ -431,6 +432,54 @@ def build_frame_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = N
 HEAD_SITE_PATH = f"{ARM_MODEL_NAME}/{HEAD_SITE}"
 
 
+_COUNTS = {"body": "nbody", "joint": "njnt", "actuator": "nu", "tendon": "ntendon",
+           "site": "nsite", "geom": "ngeom"}
+
+
+def arm_ids(model, kind: str) -> np.ndarray:
+    """Ids of the attached arm's elements of ``kind`` ("body", "joint", "actuator", ...) in
+    model order: the arm is whatever is named under its ``ARM_MODEL_NAME/`` prefix."""
+    prefix = ARM_MODEL_NAME + "/"
+    return np.array([i for i in range(getattr(model, _COUNTS[kind]))
+                     if (model.id2name(i, kind) or "").startswith(prefix)], dtype=int)
+
+
+class ArmIndices(NamedTuple):
+    """Where the attached arm sits in a compiled model (see :func:`arm_indices`)."""
+    joints: np.ndarray  # hinge joint ids, Table 1 order (atlas first)
+    qpos: np.ndarray  # their qpos addresses
+    dofs: np.ndarray  # their dof addresses
+    actuators: np.ndarray  # tendon actuator ids, in action order
+    tendons: np.ndarray  # each actuator's tendon id
+    head_site: int
+    head_body: int
+    head_velocity: int  # sensordata address of the head's linear velocity
+    servo_gain: np.ndarray  # kp of each tendon servo
+    servo_bias: np.ndarray  # kp * rest length of each tendon servo
+
+    @property
+    def rest_lengths(self) -> np.ndarray:
+        """Length of each tendon in the straight pose (m): the servo's zero contraction."""
+        return self.servo_bias / self.servo_gain  # (kp * rest) / kp, fixed at model creation
+
+
+def arm_indices(model) -> ArmIndices:
+    """Find the attached arm in ``model`` (a dm_control physics' model): the one place that
+    does; callers that read it every step cache the result per model."""
+    joints = np.array([j for j in arm_ids(model, "joint") if model.jnt_type[j] == 3],
+                      dtype=int)  # hinges
+    joints = joints[::-1]  # generator adds caudal first; Table 1 is cranial first
+    actuators = arm_ids(model, "actuator")
+    head_site = int(model.name2id(HEAD_SITE_PATH, "site"))
+    sensor = model.name2id(f"{ARM_MODEL_NAME}/{HEAD_VELOCITY_SENSOR}", "sensor")
+    return ArmIndices(joints, np.array(model.jnt_qposadr[joints]),
+                      np.array(model.jnt_dofadr[joints]), actuators,
+                      np.array(model.actuator_trnid[actuators, 0], dtype=int), head_site,
+                      int(model.site_bodyid[head_site]), int(model.sensor_adr[sensor]),
+                      -model.actuator_gainprm[actuators, 0].copy(),
+                      model.actuator_biasprm[actuators, 0].copy())
+
+
 def tendon_sides(model) -> list[str]:
     """The side (one of ``SIDES``) of each of the arm's tendons, in action order.
 
@@ -438,12 +487,9 @@ def tendon_sides(model) -> list[str]:
     (``build_arm`` names them so), so its last hole says its side whatever its name.
     ``model`` is a physics' model with an attached arm (other actuators are skipped).
     """
-    prefix = ARM_MODEL_NAME + "/"
     hole_suffixes = {side: _hole_site_name("", side) for side in SIDES}
     sides = []
-    for i in range(model.nu):
-        if not model.id2name(i, "actuator").startswith(prefix):
-            continue
+    for i in arm_ids(model, "actuator"):
         tendon = model.actuator_trnid[i, 0]
         last_site = model.wrap_objid[model.tendon_adr[tendon] + model.tendon_num[tendon] - 1]
         name = model.id2name(int(last_site), "site")
@@ -514,10 +560,7 @@ def head_attitude_deg(physics) -> float:
     """Head attitude in the world's x-z plane: 0 up, 90 level (paper Fig. 2B), 180 down,
     continuous past 180 (see :func:`continuous_attitude_deg`)."""
     axis = head_axis(physics)
-    model = physics.model
-    prefix = ARM_MODEL_NAME + "/"
-    qpos_adr = [model.jnt_qposadr[i] for i in range(model.njnt)
-                if model.jnt_type[i] == 3 and model.id2name(i, "joint").startswith(prefix)]
+    qpos_adr = arm_indices(physics.model).qpos[::-1]  # caudal first, as the sum always was
     return float(continuous_attitude_deg(float(np.degrees(np.arctan2(axis[0], axis[2]))),
                                          physics.data.qpos[qpos_adr]))
 

@@ -14,8 +14,6 @@ from dm_control.rl import control
 
 from robostrich_suite import arm as arm_lib
 
-_PREFIX = arm_lib.ARM_MODEL_NAME + "/"
-
 _log = logging.getLogger(__name__)
 
 
@@ -49,67 +47,49 @@ class ArmPhysicsMixin:
     episodes_diverged: int = 0
 
     # Indices are looked up once per model; the model never changes under a Physics.
-    def _arm_indices(self):
+    def _arm_indices(self) -> arm_lib.ArmIndices:
         cache = self.__dict__.get("_arm_index_cache")
         if cache is None or cache[0] is not self.model.ptr:
-            model = self.model
-            joints = [i for i in range(model.njnt)
-                      if model.id2name(i, "joint").startswith(_PREFIX)
-                      and model.jnt_type[i] == 3]  # hinge
-            joints = joints[::-1]  # generator adds caudal first; Table 1 is cranial first
-            actuators = [i for i in range(model.nu)
-                         if model.id2name(i, "actuator").startswith(_PREFIX)]
-            tendons = [int(model.actuator_trnid[i, 0]) for i in actuators]
-            head_site = model.name2id(arm_lib.HEAD_SITE_PATH, "site")
-            sensor = model.name2id(_PREFIX + arm_lib.HEAD_VELOCITY_SENSOR, "sensor")
-            cache = (model.ptr, np.array([model.jnt_qposadr[j] for j in joints]),
-                     np.array([model.jnt_dofadr[j] for j in joints]),
-                     np.array(actuators), np.array(tendons), head_site,
-                     int(model.site_bodyid[head_site]), int(model.sensor_adr[sensor]),
-                     -model.actuator_gainprm[actuators, 0].copy(),
-                     model.actuator_biasprm[actuators, 0].copy())
+            cache = (self.model.ptr, arm_lib.arm_indices(self.model))
             self.__dict__["_arm_index_cache"] = cache
-        return cache[1:]
+        return cache[1]
 
     def arm_joint_names(self) -> list[str]:
-        qpos_adr = self._arm_indices()[0]
-        return [self.model.id2name(int(np.where(self.model.jnt_qposadr == a)[0][0]), "joint")
-                for a in qpos_adr]
+        return [self.model.id2name(int(j), "joint") for j in self._arm_indices().joints]
 
     def tendon_names(self) -> list[str]:
-        return [self.model.id2name(int(i), "actuator") for i in self._arm_indices()[2]]
+        return [self.model.id2name(int(i), "actuator") for i in self._arm_indices().actuators]
 
     def head_position(self) -> np.ndarray:
         """Head site position (x, y, z) in metres, world frame."""
-        return self.data.site_xpos[self._arm_indices()[4]].copy()
+        return self.data.site_xpos[self._arm_indices().head_site].copy()
 
     def head_velocity(self) -> np.ndarray:
         """Head site linear velocity (x, y, z) in m/s, world frame."""
-        adr = self._arm_indices()[6]
+        adr = self._arm_indices().head_velocity
         return self.data.sensordata[adr:adr + 3].copy()
 
     def head_attitude(self) -> float:
         """Head attitude in degrees: 90 = head parallel to the ground (paper Fig. 2B); continuous
         past 180 (no wrap), see :func:`arm.continuous_attitude_deg`."""
-        xmat = self.data.xmat[self._arm_indices()[5]]  # row-major 3x3; column 2 = head axis
+        xmat = self.data.xmat[self._arm_indices().head_body]  # row-major 3x3; column 2 = head axis
         return float(arm_lib.continuous_attitude_deg(np.degrees(np.arctan2(xmat[2], xmat[8])),
-                                                     self.data.qpos[self._arm_indices()[0]]))
+                                                     self.data.qpos[self._arm_indices().qpos]))
 
     def joint_angles(self) -> np.ndarray:
         """The 18 joint angles (rad), atlas first; positive = ventral flexion."""
-        return self.data.qpos[self._arm_indices()[0]].copy()
+        return self.data.qpos[self._arm_indices().qpos].copy()
 
     def joint_velocities(self) -> np.ndarray:
-        return self.data.qvel[self._arm_indices()[1]].copy()
+        return self.data.qvel[self._arm_indices().dofs].copy()
 
     def tendon_lengths(self) -> np.ndarray:
         """Current length of each actuated tendon (m), in action order."""
-        return self.data.ten_length[self._arm_indices()[3]].copy()
+        return self.data.ten_length[self._arm_indices().tendons].copy()
 
     def tendon_rest_lengths(self) -> np.ndarray:
         """Length of each tendon in the straight pose (m): the servo's zero contraction."""
-        indices = self._arm_indices()
-        return indices[8] / indices[7]  # (kp * rest) / kp, fixed at model creation
+        return self._arm_indices().rest_lengths
 
     def tendon_contractions(self) -> np.ndarray:
         """How much each tendon is shorter than at rest (m)."""
@@ -117,22 +97,22 @@ class ArmPhysicsMixin:
 
     def tendon_forces(self) -> np.ndarray:
         """Pull in each tendon (N, >= 0), in action order."""
-        return -self.data.actuator_force[self._arm_indices()[2]].copy()
+        return -self.data.actuator_force[self._arm_indices().actuators].copy()
 
     def tendon_max_forces(self) -> np.ndarray:
         """Largest pull of each tendon's actuator (N, > 0), in action order."""
-        return -self.model.actuator_forcerange[self._arm_indices()[2], 0]
+        return -self.model.actuator_forcerange[self._arm_indices().actuators, 0]
 
     def arm_control(self) -> np.ndarray:
-        return self.data.ctrl[self._arm_indices()[2]].copy()
+        return self.data.ctrl[self._arm_indices().actuators].copy()
 
     def arm_control_range(self) -> np.ndarray:
         """(9, 2) low/high tendon contractions (m): the action spec's bounds."""
-        return self.model.actuator_ctrlrange[self._arm_indices()[2]]
+        return self.model.actuator_ctrlrange[self._arm_indices().actuators]
 
     def set_arm_control(self, action) -> None:
         """Write tendon contractions to the arm's actuators only (a robot may have others)."""
-        self.data.ctrl[self._arm_indices()[2]] = action
+        self.data.ctrl[self._arm_indices().actuators] = action
 
     def step(self, nstep: int = 1) -> None:
         """Step, but turn a divergence into a flag the task ends the episode on.

@@ -169,12 +169,6 @@ class MovementConfig:
 PAPER_LAYOUT = dict(ventral_span=None, dorsal_hold="length", release=False, ramp_time=1.0)
 
 
-def servo_rest_lengths(model) -> np.ndarray:
-    """Each tendon servo's length at zero input (the affine bias is kp * rest length);
-    a tendon's contraction is this minus its current length."""
-    return model.actuator_biasprm[:, 0] / -model.actuator_gainprm[:, 0]
-
-
 def hold_dorsal_length(dorsal_input: float, target: float, contraction: float, dt: float,
                        control_range) -> float:
     """One step of the integral loop that holds the dorsal tendon at ``target`` contraction
@@ -292,8 +286,8 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
     config.validate(len(ventral))
     dorsal = arm_lib.dorsal_index(physics.model)
     model = physics.model
-    tendon_ids = model.actuator_trnid[:, 0]
-    rest = servo_rest_lengths(model)
+    indices = arm_lib.arm_indices(model)
+    tendon_ids, rest = indices.tendons, indices.rest_lengths
     targets = schedule(config, physics)
     dt = model.opt.timestep
     steps = int(round(config.duration(len(ventral)) / dt))
@@ -424,8 +418,8 @@ def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int
     physics = workspace.frame_physics(spec, layout)
     model = physics.model
     ventral, dorsal_id = arm_lib.ventral_indices(physics.model), arm_lib.dorsal_index(physics.model)
-    tendon_ids = model.actuator_trnid[:, 0]
-    rest = servo_rest_lengths(model)
+    indices = arm_lib.arm_indices(model)
+    tendon_ids, rest = indices.tendons, indices.rest_lengths
     high = model.actuator_ctrlrange[ventral, 1]
     rng = np.random.default_rng(seed)
     inputs = rng.uniform(size=(num_poses, len(ventral))) ** 2 * high

@@ -35,12 +35,13 @@ HOLD_TIME = DEFAULT_TIME_LIMIT  # s a candidate is held from the fixed start: on
 def contraction_at(physics, joint_angles: np.ndarray, spec: arm_lib.ArmSpec) -> np.ndarray:
     """Every tendon's contraction (servo rest length minus length) in the pose ``joint_angles``."""
     model = physics.model
-    qpos_adr = model.jnt_qposadr[workspace._arm_joint_ids(physics, spec)]
+    indices = arm_lib.arm_indices(model)
+    qpos_adr = indices.qpos
     with physics.reset_context():
         physics.data.qpos[qpos_adr] = joint_angles
-    lengths = np.array(physics.data.ten_length[model.actuator_trnid[:, 0]])
+    lengths = np.array(physics.data.ten_length[indices.tendons])
     physics.reset()
-    return movement.servo_rest_lengths(model) - lengths
+    return indices.rest_lengths - lengths
 
 
 def seek_pose(physics, target_xz, control, seek_time: float = SEEK_TIME,
@@ -96,7 +97,7 @@ def seek_samples(targets_xz, joint_angles, spec: arm_lib.ArmSpec | None = None,
         result.settled[i] = workspace.settle(physics, control, hold_time)
         result.head_position[i] = workspace.head_position_xz(physics)
         result.head_attitude[i] = workspace.head_attitude_deg(physics)
-        result.joint_angles[i] = workspace.arm_joint_angles(physics, spec)
+        result.joint_angles[i] = workspace.arm_joint_angles(physics)
         if progress is not None:
             progress(1)
     return result

@@ -17,8 +17,6 @@ import numpy as np
 
 from robostrich_suite import arm as arm_lib
 
-_PREFIX = arm_lib.ARM_MODEL_NAME + "/"
-
 
 @dataclasses.dataclass(frozen=True)
 class DomainRandomization:
@@ -46,16 +44,12 @@ class Randomizer:
         self.config = config
         self._nominal = None
 
-    def _arm_ids(self, model, kind, count):
-        return np.array([i for i in range(count)
-                         if (model.id2name(i, kind) or "").startswith(_PREFIX)], dtype=int)
-
     def _remember(self, physics):
         model = physics.model
-        bodies = self._arm_ids(model, "body", model.nbody)
-        joints = self._arm_ids(model, "joint", model.njnt)
+        bodies = arm_lib.arm_ids(model, "body")
+        joints = arm_lib.arm_ids(model, "joint")
         dofs = model.jnt_dofadr[joints]
-        actuators = self._arm_ids(model, "actuator", model.nu)
+        actuators = arm_lib.arm_ids(model, "actuator")
         self._nominal = dict(
             bodies=bodies, joints=joints, dofs=dofs, actuators=actuators,
             mass=model.body_mass[bodies].copy(), inertia=model.body_inertia[bodies].copy(),

@@ -230,19 +230,18 @@ class Physics(arm_physics.ArmPhysicsMixin, mujoco.Physics):
                 leg_actuators=np.array([model.name2id(n, "actuator") for n in legs]),
                 leg_qpos=np.array([model.jnt_qposadr[model.name2id(n, "joint")] for n in legs]),
                 # The arm's first (caudal) joint: the generator adds the chain caudal first.
-                arm_base=next(int(model.jnt_bodyid[i]) for i in range(model.njnt)
-                              if model.id2name(i, "joint").startswith(ARM_PREFIX)))
+                arm_base=int(model.jnt_bodyid[arm_lib.arm_ids(model, "joint")[0]]))
             self.__dict__["_robot_cache"] = cache
         return cache
 
     # Arm head.
     def head_attitude(self) -> float:
         """Head attitude (deg) in the trunk's heading plane: 0 up, 90 level, 180 down."""
-        xmat = self.data.xmat[self._arm_indices()[5]]  # head body; row-major: axis z = (2, 5, 8)
+        xmat = self.data.xmat[self._arm_indices().head_body]  # head body; row-major: axis z = (2, 5, 8)
         hx, hy = self.heading()
         return float(arm_lib.continuous_attitude_deg(
             math.degrees(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8])),
-            self.data.qpos[self._arm_indices()[0]]))
+            self.data.qpos[self._arm_indices().qpos]))
 
     # Quadruped.
     def trunk_position(self) -> np.ndarray:

@@ -60,17 +60,9 @@ def head_attitude_deg(physics: mjcf.Physics) -> float:
     return arm_lib.head_attitude_deg(physics)
 
 
-def _arm_joint_ids(physics: mjcf.Physics, spec: arm_lib.ArmSpec) -> np.ndarray:
-    """MuJoCo joint ids of the arm in Table 1 order (atlas first)."""
-    return np.array([physics.model.name2id(f"{arm_lib.ARM_MODEL_NAME}/{name}", "joint")
-                     for name in spec.joint_names])
-
-
-def arm_joint_angles(physics: mjcf.Physics, spec: arm_lib.ArmSpec | None = None) -> np.ndarray:
+def arm_joint_angles(physics: mjcf.Physics) -> np.ndarray:
     """The arm's joint angles (rad) in Table 1 order (atlas first)."""
-    spec = spec or arm_lib.ArmSpec.from_table1()
-    ids = _arm_joint_ids(physics, spec)
-    return np.array(physics.data.qpos[physics.model.jnt_qposadr[ids]])
+    return np.array(physics.data.qpos[arm_lib.arm_indices(physics.model).qpos])
 
 
 def base_joint_xz(physics: mjcf.Physics, spec: arm_lib.ArmSpec | None = None) -> np.ndarray:
@@ -139,9 +131,8 @@ def kinematic_samples(num_samples: int, seed: int = 0, spec: arm_lib.ArmSpec | N
     angles = sample_joint_angles(num_samples, num_edge, np.random.default_rng(seed), spec)
     total = len(angles)
     model, data = physics.model.ptr, physics.data.ptr
-    qpos_adr = physics.model.jnt_qposadr[_arm_joint_ids(physics, spec)]
-    site = physics.model.name2id(arm_lib.HEAD_SITE_PATH, "site")
-    head_body = physics.model.site_bodyid[site]
+    indices = arm_lib.arm_indices(physics.model)
+    qpos_adr, site, head_body = indices.qpos, indices.head_site, indices.head_body
     positions = np.empty((total, 2))
     axes = np.empty((total, 2))
     iterator = range(total)
@@ -245,7 +236,7 @@ def actuated_samples(num_samples: int, seed: int = 0, settle_time: float = 1.5,
         settled[i] = settle(physics, controls[i], settle_time)
         positions[i] = head_position_xz(physics)
         attitudes[i] = head_attitude_deg(physics)
-        angles[i] = arm_joint_angles(physics, spec)
+        angles[i] = arm_joint_angles(physics)
     return ActuatedSamples(positions, attitudes, controls, settled, angles)
 
 

@@ -227,3 +227,25 @@ def test_tendon_sides_come_from_the_model_not_the_names():
     assert arm.ventral_indices(model) == [0, 1]
     default = Physics.from_xml_string(*get_model_and_assets()).model
     assert arm.dorsal_index(default) == 0 and arm.ventral_indices(default) == list(range(1, 9))
+
+
+def test_arm_indices_name_what_they_find():
+    """arm_indices finds the arm by its prefix, in Table 1 and action order, on the frame and
+    on the quadruped (whose legs it must skip)."""
+    from robostrich_suite import robostrich_a1
+    for physics in (Physics.from_xml_string(*get_model_and_assets()),
+                    robostrich_a1.Physics.from_xml_string(*robostrich_a1.get_model_and_assets())):
+        model = physics.model
+        indices = arm.arm_indices(model)
+        assert [model.id2name(int(j), "joint") for j in indices.joints] == [
+            f"arm/{n}" for n in arm.ArmSpec.from_table1().joint_names]
+        assert [model.id2name(int(a), "actuator") for a in indices.actuators] == [
+            f"arm/{n}" for n in arm.TendonLayout.robostrich().names]
+        assert [model.id2name(int(t), "tendon") for t in indices.tendons] == [
+            f"arm/{n}" for n in arm.TendonLayout.robostrich().names]
+        assert model.id2name(indices.head_site, "site") == arm.HEAD_SITE_PATH
+        assert model.site_bodyid[indices.head_site] == indices.head_body
+        with physics.reset_context():
+            pass  # straight neck: every tendon at its rest length
+        np.testing.assert_allclose(indices.rest_lengths, physics.data.ten_length[indices.tendons],
+                                   atol=1e-9)

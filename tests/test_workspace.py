@@ -70,7 +70,7 @@ def test_actuated_poses_lie_in_the_kinematic_workspace(actuated, physics):
     assert np.all(angles >= limits[:, 0] - tolerance)
     assert np.all(angles <= limits[:, 1] + tolerance)
     clamped = np.clip(angles, limits[:, 0], limits[:, 1])
-    qpos_adr = physics.model.jnt_qposadr[workspace._arm_joint_ids(physics, spec)]
+    qpos_adr = arm.arm_indices(physics.model).qpos
     for pose, head in zip(clamped, actuated.head_position[actuated.settled]):
         with physics.reset_context():
             physics.data.qpos[qpos_adr] = pose
