@@ -226,9 +226,10 @@ class Reach(base.Task):
         obs["joint_angles"] = joint_angles
         obs["target_position"] = self.target_position.copy()
         obs["to_target"] = self.target_position - head
-        attitude_error = self.attitude_error(physics)
+        attitude = physics.head_attitude()  # once: it is the costliest measurement of a step
+        attitude_error = float(arm_lib.attitude_error_deg(attitude, self.desired_attitude))
         obs["attitude_error"] = np.array([np.radians(attitude_error)])
-        obs["head_attitude"] = np.array([np.radians(physics.head_attitude())])
+        obs["head_attitude"] = np.array([np.radians(attitude)])
         obs["tendon_contraction"] = physics.tendon_contractions()
         obs["tendon_tension"] = physics.tendon_forces() / physics.tendon_max_forces()
         return obs
