@@ -623,6 +623,9 @@ def main(argv=None) -> dict:
     if args.paper_layout:
         setting.update(PAPER_LAYOUT)
     base = MovementConfig(**setting)
+    ventral = sum(t.side == "ventral" for t in base.layout(spec).tendons)
+    for pattern in args.patterns:  # every bad setting before anything is written
+        dataclasses.replace(base, pattern=pattern).validate(ventral)
     progress = not args.no_progress
     written, results = [], {}
     start = time.perf_counter()

@@ -125,6 +125,7 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
         "truncated": start("robostrich-evaluate", tmp_path / "truncated.pkl", "--num-targets", "1", "--no-rerun",
                            "--no-figures"),
         "empty": start("robostrich-evaluate", tmp_path / "empty.pkl", "--num-targets", "1"),
+        "ramp_negative": start("robostrich-movement", "--ramp-time", "-1", "--out", tmp_path / "mv"),
     }
     results = {case: finish(p) for case, p in cases.items()}
     assert_user_error(results["resume_empty"], "--resume", "no checkpoint", str(empty))
@@ -133,7 +134,9 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     assert results["checkpoint_every_0"].returncode == 2 and not (tmp_path / "ck0").exists()
     assert_user_error(results["truncated"], "truncated.pkl", "damaged")
     assert_user_error(results["empty"], "empty.pkl", "not a robostrich SAC checkpoint")
-    for case in ("resume_empty", "truncated", "empty"):
+    assert_user_error(results["ramp_negative"], "ramp_time")
+    assert not list(tmp_path.glob("mv/*.rrd"))  # refused before the recording was opened
+    for case in ("resume_empty", "truncated", "empty", "ramp_negative"):
         assert results[case].returncode == 2, (case, results[case].stderr)
 
 
