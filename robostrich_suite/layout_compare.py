@@ -30,6 +30,7 @@ import time
 import numpy as np
 
 from robostrich_suite import arm as arm_lib
+from robostrich_suite import cli as cli_lib
 from robostrich_suite import coverage as coverage_lib
 from robostrich_suite import layouts as layouts_lib
 from robostrich_suite import movement, pose_seek, targets, workspace
@@ -307,19 +308,10 @@ def write_csv(path: pathlib.Path, rows) -> None:
 
 # --------------------------------------------------------------------------- command line
 
-def _positive(kind):
-    def parse(text):
-        value = kind(text)
-        if not value > 0:
-            raise argparse.ArgumentTypeError(f"must be positive, got {text}")
-        return value
-    return parse
-
-
-def _non_negative_int(text):
-    value = int(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be 0 or more, got {text}")
+def _positive_float(text):
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be positive, got {text}")
     return value
 
 
@@ -343,16 +335,16 @@ def main(argv=None) -> dict:
     parser.add_argument("--layout-file", nargs="+", default=[], type=pathlib.Path, metavar="FILE",
                         help="also compare layouts from JSON/TOML files (see "
                              "robostrich_suite/layouts.py for the format)")
-    parser.add_argument("--stiffness", nargs="+", type=_positive(float), default=[],
+    parser.add_argument("--stiffness", nargs="+", type=_positive_float, default=[],
                         metavar="N_M_PER_RAD",
                         help="passive joint stiffnesses to sweep, every layout at each "
                              "(default: the arm's own)")
-    parser.add_argument("--kinematic-samples", type=_positive(int), default=DEFAULT_KINEMATIC_SAMPLES,
+    parser.add_argument("--kinematic-samples", type=cli_lib.whole_number(1), default=DEFAULT_KINEMATIC_SAMPLES,
                         help="uniform kinematic samples that make the blue region (default: %(default)s)")
-    parser.add_argument("--random-samples", type=_non_negative_int, default=DEFAULT_RANDOM_SAMPLES,
+    parser.add_argument("--random-samples", type=cli_lib.whole_number(0), default=DEFAULT_RANDOM_SAMPLES,
                         help="random held inputs per case, dorsal tuned for a level head "
                              "(default: %(default)s)")
-    parser.add_argument("--seek-time", type=_positive(float), default=pose_seek.SEEK_TIME,
+    parser.add_argument("--seek-time", type=cli_lib.seconds(), default=pose_seek.SEEK_TIME,
                         help="seconds of input adjustment per sought blue-region pose "
                              "(default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
@@ -361,9 +353,9 @@ def main(argv=None) -> dict:
     parser.add_argument("--train", action="store_true",
                         help="also train a short curriculum per case on its own targets and "
                              "report its held-out success")
-    parser.add_argument("--train-steps", type=_positive(int), default=DEFAULT_TRAIN_STEPS,
+    parser.add_argument("--train-steps", type=cli_lib.whole_number(1), default=DEFAULT_TRAIN_STEPS,
                         help="control steps of that run, split over lessons 1-3 (default: %(default)s)")
-    parser.add_argument("--workers", type=_positive(int), default=1,
+    parser.add_argument("--workers", type=cli_lib.whole_number(1), default=1,
                         help="processes, one case each (default: %(default)s)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
@@ -404,7 +396,6 @@ def main(argv=None) -> dict:
 
 def cli(argv=None) -> int:
     """Console script `robostrich-layouts`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
-    from robostrich_suite import cli as cli_lib
     return cli_lib.run(main, PROG, argv)
 
 
