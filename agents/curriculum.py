@@ -17,7 +17,7 @@ from agents import checkpoint
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 
-ROBOSTRICH_DOMAINS = ("robostrich",)
+from agents.domains import as_domain
 
 
 @dataclasses.dataclass(frozen=True)
@@ -49,14 +49,10 @@ def format_plan(plan: Sequence[Lesson]) -> str:
     return ",".join(f"{l.domain}/{l.task}:{l.steps}" for l in plan)
 
 
-def make_environment(domain: str, task: str, seed: int, **task_kwargs):
-    """robostrich_suite.load for the arm, dm_control.suite.load otherwise (used in development and tests)."""
-    task_kwargs = {"random": seed, **task_kwargs}
-    if domain in ROBOSTRICH_DOMAINS:
-        import robostrich_suite
-        return robostrich_suite.load(domain, task, task_kwargs=task_kwargs)
-    from dm_control import suite
-    return suite.load(domain, task, task_kwargs=task_kwargs)
+def make_environment(domain, task: str, seed: int, **task_kwargs):
+    """robostrich_suite.load for the arm domains, dm_control.suite.load otherwise (agents/domains.py);
+    `domain` is a name or an agents.domains.Domain (which may carry a tendon layout)."""
+    return as_domain(domain).make_environment(task, seed, **task_kwargs)
 
 
 class TrainingInterrupted(RuntimeError):
@@ -76,9 +72,13 @@ class CurriculumRun:
 
     def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
                  checkpoint_every: int = 10_000, env_factory: Callable = make_environment, name: str = "run",
-                 task_kwargs: Optional[dict] = None):
-        """``task_kwargs`` go to every lesson's task (e.g. eq. 10's ``weights``)."""
+                 task_kwargs: Optional[dict] = None, layout: Optional[str] = None):
+        """``task_kwargs`` go to every lesson's task (e.g. eq. 10's ``weights``); ``layout`` names a
+        built-in tendon layout of the arm domains (its own targets come with it)."""
         self.task_kwargs = dict(task_kwargs or {})
+        self.layout = layout
+        for lesson in plan:  # an unknown layout or a layout on dm_control fails here, not mid-run
+            as_domain(lesson.domain, layout)
         self.plan = list(plan)
         self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
         self.checkpoint_every = int(checkpoint_every)
@@ -86,7 +86,9 @@ class CurriculumRun:
         self.lesson_index = 0
         self.lesson_steps = 0
         os.makedirs(run_dir, exist_ok=True)
-        self.loop = SACBuilder(config).make_components(self._make_lesson_env(0), seed)
+        base = self.domain(self.plan[0])  # a residual policy adds to this domain's (and layout's) lookup
+        self.loop = SACBuilder(config).make_components(self._make_lesson_env(0), seed,
+                                                       base.lookup_table() if config.residual_scale > 0 else None)
         self.checkpoint_path = os.path.join(run_dir, "checkpoint.pkl")
         self.metrics_path = os.path.join(run_dir, "metrics.jsonl")
         self.evals_path = os.path.join(run_dir, "evals.jsonl")
@@ -94,7 +96,12 @@ class CurriculumRun:
     # -- lessons ---------------------------------------------------------------------------
     def _make_lesson_env(self, index):
         lesson = self.plan[index]
-        return self.env_factory(lesson.domain, lesson.task, self.seed + 1000 * (index + 1), **self.task_kwargs)
+        return self.env_factory(self.domain(lesson), lesson.task, self.seed + 1000 * (index + 1),
+                                **self.task_kwargs)
+
+    def domain(self, lesson: Optional[Lesson] = None):
+        """The agents.domains.Domain of `lesson` (default: the last), with this run's layout."""
+        return as_domain((lesson or self.plan[-1]).domain, self.layout)
 
     @property
     def total_steps(self) -> int:
@@ -118,6 +125,8 @@ class CurriculumRun:
                        "action_size": self.loop.actor.adapter.size}
         if self.task_kwargs:
             fingerprint["task_kwargs"] = self.task_kwargs
+        if self.layout is not None:
+            fingerprint["layout"] = self.layout
         return fingerprint
 
     def state_dict(self) -> dict:

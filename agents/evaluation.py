@@ -18,7 +18,8 @@ from typing import Optional
 import numpy as np
 
 from agents import probes
-from agents.curriculum import ROBOSTRICH_DOMAINS, make_environment
+from agents.curriculum import make_environment
+from agents.domains import as_domain
 
 
 def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dict:
@@ -94,21 +95,22 @@ def summarize(episodes) -> dict:
     }
 
 
-def default_heldout_task(domain: str, final_task: str) -> str:
-    """lesson2 on robostrich: reward eq. 10 from the fixed initial pose, so every target starts alike."""
-    return "lesson2" if domain in ROBOSTRICH_DOMAINS else final_task
+def default_heldout_task(domain, final_task: str) -> str:
+    """lesson2 on the arm: reward eq. 10 from the fixed initial pose, so every target starts alike."""
+    return as_domain(domain).heldout_task(final_task)
 
 
-def heldout_targets(domain: str, num_targets: Optional[int] = None):
-    """robostrich_suite.targets.heldout_targets() for the arm; None (seeded episodes) elsewhere."""
-    if domain not in ROBOSTRICH_DOMAINS:
-        return None
-    from robostrich_suite import targets
-    pool = np.asarray(targets.heldout_targets(), np.float64)
-    return pool if num_targets is None else pool[:num_targets]
+def heldout_targets(domain, num_targets: Optional[int] = None):
+    """The arm domain's (and layout's) held-out targets; None (seeded episodes) elsewhere."""
+    return as_domain(domain).heldout_targets(num_targets)
 
 
-def evaluate_heldout(actor, flattener, domain: str, task: str, num_targets: Optional[int] = None,
+def _names(domain) -> dict:
+    domain = as_domain(domain)
+    return {"domain": domain.name, **({"layout": domain.layout} if domain.layout else {})}
+
+
+def evaluate_heldout(actor, flattener, domain, task: str, num_targets: Optional[int] = None,
                      seed: int = 10_000, targets=None, action_repeat: int = 1) -> dict:
     """Deterministic policy, one episode per held-out target (a pool of that single target).
 
@@ -130,20 +132,16 @@ def evaluate_heldout(actor, flattener, domain: str, task: str, num_targets: Opti
         if targets is not None:
             row["target"] = targets[i].tolist()
         episodes.append(row)
-    return {"kind": "heldout", "domain": domain, "task": task, "summary": summarize(episodes), "episodes": episodes}
+    return {"kind": "heldout", **_names(domain), "task": task, "summary": summarize(episodes), "episodes": episodes}
 
 
-def moving_starts(count: int = 3):
+def moving_starts(count: int = 3, domain="robostrich"):
     """Start poses of `heldout_moving`: `count` well separated training targets (picked as `track` picks its
     targets) and the stored inputs that hold them (from the lookup table, so never a held-out pose)."""
-    from agents.lookup import lookup_table, nearest
-    from robostrich_suite import reach, targets
-    table = lookup_table()
-    starts = reach.default_track_targets(targets.training_targets(), count)
-    return starts, np.stack([table["control"][nearest(table, s)] for s in starts])
+    return as_domain(domain).moving_starts(count)
 
 
-def evaluate_heldout_moving(actor, flattener, domain: str = "robostrich", num_targets: Optional[int] = None,
+def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: Optional[int] = None,
                             seed: int = 30_000, targets=None, starts=None, action_repeat: int = 1) -> dict:
     """Every held-out target from poses where the arm holds another target (lesson 3's situation).
 
@@ -153,7 +151,7 @@ def evaluate_heldout_moving(actor, flattener, domain: str = "robostrich", num_ta
     that final state, with the held-out target.  `starts` = (positions, controls).
     """
     targets = heldout_targets(domain, num_targets) if targets is None else np.asarray(targets, np.float64)
-    start_positions, start_controls = moving_starts() if starts is None else starts
+    start_positions, start_controls = moving_starts(domain=domain) if starts is None else starts
     env = make_environment(domain, "lesson3", seed, target_pool=targets[:1])
     episodes = []
     for k, (start, control) in enumerate(zip(start_positions, start_controls)):
@@ -168,11 +166,11 @@ def evaluate_heldout_moving(actor, flattener, domain: str = "robostrich", num_ta
             row.update(target=np.asarray(target).tolist(), start=k, start_target=np.asarray(start).tolist(),
                        start_position_error=start_error[0], start_attitude_error=start_error[1])
             episodes.append(row)
-    return {"kind": "heldout_moving", "domain": domain, "task": "lesson3", "summary": summarize(episodes),
+    return {"kind": "heldout_moving", **_names(domain), "task": "lesson3", "summary": summarize(episodes),
             "episodes": episodes}
 
 
-def evaluate_track(actor, flattener, domain: str = "robostrich", task: str = "track", seed: int = 20_000,
+def evaluate_track(actor, flattener, domain="robostrich", task: str = "track", seed: int = 20_000,
                    recorder=None, action_repeat: int = 1) -> dict:
     """The `track` task: targets in order (Fig. 7); one summary per target segment plus the series."""
     env = make_environment(domain, task, seed)
@@ -184,11 +182,11 @@ def evaluate_track(actor, flattener, domain: str = "robostrich", task: str = "tr
         row = _episode_summary(series, start, end)
         row.update(start_step=start, target=targets[start] if targets else None)
         segments.append(row)
-    return {"kind": "track", "domain": domain, "task": task, "segments": segments,
+    return {"kind": "track", **_names(domain), "task": task, "segments": segments,
             "summary": summarize(segments), "series": series}
 
 
-def evaluate_agent(actor, flattener, out_dir: str, label: str, domain: str, heldout_task: str,
+def evaluate_agent(actor, flattener, out_dir: str, label: str, domain, heldout_task: str,
                    track_task: Optional[str], num_targets: Optional[int] = None, env_steps: int = None,
                    record: bool = True, action_repeat: int = 1) -> dict:
     """Held-out (+ from moving starts on the arm) + track evaluation, JSON reports and (optionally) a Rerun
@@ -196,7 +194,7 @@ def evaluate_agent(actor, flattener, out_dir: str, label: str, domain: str, held
     os.makedirs(out_dir, exist_ok=True)
     reports = {"heldout": evaluate_heldout(actor, flattener, domain, heldout_task, num_targets,
                                            action_repeat=action_repeat)}
-    if domain in ROBOSTRICH_DOMAINS:
+    if as_domain(domain).has_moving_starts:
         reports["heldout_moving"] = evaluate_heldout_moving(actor, flattener, domain, num_targets,
                                                             action_repeat=action_repeat)
     if track_task:
@@ -227,18 +225,19 @@ def read_reports(out_dir: str, label: str) -> dict:
     return reports
 
 
-def evaluate_lookup(out_dir: str, domain: str, heldout_task: str, track_task: Optional[str],
+def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optional[str],
                     num_targets: Optional[int] = None, record: bool = True) -> Optional[dict]:
     """`evaluate_agent` for the lookup baseline (label `lookup`) on the arm; None on other domains.
 
     Action repeat 1: the lookup's input only changes with the target.
     """
-    if domain not in ROBOSTRICH_DOMAINS:
+    domain = as_domain(domain)
+    if not domain.is_arm:
         return None
     from agents.lookup import LABEL, LookupPolicy
     from agents.replay import ObservationFlattener
     flattener = ObservationFlattener(make_environment(domain, heldout_task, 0).observation_spec())
-    return evaluate_agent(LookupPolicy(flattener), flattener, out_dir, LABEL, domain, heldout_task, track_task,
+    return evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain, heldout_task, track_task,
                           num_targets, env_steps=0, record=record, action_repeat=1)
 
 
@@ -271,7 +270,7 @@ def load_run_from_checkpoint(path: str):
     scratch = tempfile.mkdtemp(prefix="robostrich-evaluate-")  # the run's own files are left untouched
     try:
         run = CurriculumRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch,
-                            task_kwargs=fp.get("task_kwargs"))
+                            task_kwargs=fp.get("task_kwargs"), layout=fp.get("layout"))
         run.restore(path)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
@@ -292,11 +291,11 @@ def main(argv=None):
     parser.add_argument("--no-figures", action="store_true")
     args = parser.parse_args(argv)
     run = load_run_from_checkpoint(args.checkpoint)
-    domain = run.plan[-1].domain
+    domain = run.domain()
     out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.checkpoint)), "evaluation")
     from agents.sac.builder import SACBuilder
     actor = SACBuilder.make_eval_actor(run.loop)
-    track_task = args.track_task if domain in ROBOSTRICH_DOMAINS else None
+    track_task = domain.track_task(args.track_task)
     heldout_task = args.heldout_task or default_heldout_task(domain, run.plan[-1].task)
     reports = {args.label: evaluate_agent(actor, run.loop.flattener, out, args.label, domain, heldout_task,
                                           track_task or None, args.num_targets,

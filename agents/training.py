@@ -24,8 +24,8 @@ from typing import Optional
 import numpy as np
 
 from agents import evaluation
-from agents.curriculum import (ROBOSTRICH_DOMAINS, CurriculumRun, Lesson, format_plan,
-                               parse_plan)
+from agents.curriculum import CurriculumRun, Lesson, format_plan, parse_plan
+from agents.domains import Domain
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 
@@ -106,6 +106,9 @@ def build_parser():
     p.add_argument("--plan", default=None,
                    help="explicit plan '[domain/]task:steps,...' (overrides --steps/--lessons)")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--layout", default=None,
+                   help="built-in tendon layout of the arm (robostrich-layouts --list); its own shipped level "
+                        "poses give the training and held-out targets and the lookup table (default: the paper's)")
     p.add_argument("--task-kwargs", type=_json_object, default={},
                    help="JSON object passed to every training lesson's task, e.g. eq. 10's weights: "
                         "'{\"weights\": {\"position_error\": 10}}' (evaluation keeps the task's defaults)")
@@ -208,7 +211,7 @@ def read_jsonl(path):
 class RunJob:
     """What a run does besides training: periodic and final evaluation (picklable, for a worker)."""
 
-    domain: str
+    domain: Domain
     heldout_task: str
     track_task: Optional[str]
     eval_at: tuple
@@ -240,7 +243,7 @@ def train_and_evaluate(run: CurriculumRun, job: RunJob, progress=None) -> dict:
         run.run(progress=progress, on_eval=on_eval, eval_at=job.eval_at, stop_at_step=job.stop_at_step)
         timing = {"seconds": time.time() - start, "env_steps": run.loop.env_steps - start_steps,
                   "updates": run.loop.learner.num_updates}
-    num_targets = job.final_eval_targets or (None if job.domain in ROBOSTRICH_DOMAINS else job.num_eval_targets)
+    num_targets = job.final_eval_targets or (None if job.domain.is_arm else job.num_eval_targets)
     reports = evaluation.evaluate_agent(SACBuilder.make_eval_actor(run.loop), run.loop.flattener, job.out_eval,
                                         run.name, job.domain, job.heldout_task, job.track_task, num_targets,
                                         env_steps=run.loop.env_steps, record=job.record,
@@ -265,10 +268,10 @@ class _QueueProgress:
         pass
 
 
-def _worker(label, plan, config_dict, seed, run_dir, checkpoint_every, task_kwargs, job, queue):
+def _worker(label, plan, config_dict, seed, run_dir, checkpoint_every, task_kwargs, layout, job, queue):
     """One run in its own process: restore its latest checkpoint (if any), train, evaluate."""
     run = CurriculumRun(plan, SACConfig.from_dict(config_dict), seed, run_dir,
-                        checkpoint_every=checkpoint_every, name=label, task_kwargs=task_kwargs)
+                        checkpoint_every=checkpoint_every, name=label, task_kwargs=task_kwargs, layout=layout)
     if os.path.exists(run.checkpoint_path):
         run.restore()
     try:
@@ -300,7 +303,7 @@ def _train_in_parallel(runs: dict, job: RunJob, progress, workers: int) -> dict:
                 run = runs[label]  # a fresh worker builds the same run from the same seed, or restores it
                 process = context.Process(target=_worker, args=(
                     label, run.plan, run.config.to_dict(), run.seed, run.run_dir, run.checkpoint_every,
-                    run.task_kwargs, job, queue))
+                    run.task_kwargs, run.layout, job, queue))
                 process.start()
                 active[label] = process
             try:
@@ -341,9 +344,11 @@ def main(argv=None):
     plan = plan_from_args(args)
     total = sum(l.steps for l in plan)
     final = plan[-1]
-    domain = final.domain
-    heldout_task = args.heldout_task or evaluation.default_heldout_task(domain, final.task)
-    track_task = args.track_task if domain in ROBOSTRICH_DOMAINS else None
+    domain = Domain(final.domain, args.layout)
+    for lesson in plan:  # a typo fails now, not after the first lessons have trained
+        Domain(lesson.domain).check_task(lesson.task)
+    heldout_task = args.heldout_task or domain.heldout_task(final.task)
+    track_task = domain.track_task(args.track_task)
     run_plans = {"curriculum": plan}
     if args.baseline:
         run_plans["baseline"] = [Lesson(final.domain, final.task, total)]
@@ -364,6 +369,8 @@ def main(argv=None):
             expected = {"config": config.to_dict(), "plan": format_plan(run_plans[label]), "seed": args.seed}
             if args.task_kwargs:
                 expected["task_kwargs"] = args.task_kwargs
+            if args.layout is not None:
+                expected["layout"] = args.layout
             stored = checkpoint.read_fingerprint(path)
             checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
     os.makedirs(args.out, exist_ok=True)
@@ -375,7 +382,8 @@ def main(argv=None):
     runs = {}
     for label, run_plan in run_plans.items():
         run = CurriculumRun(run_plan, config, args.seed, os.path.join(args.out, label),
-                            checkpoint_every=args.checkpoint_every, name=label, task_kwargs=args.task_kwargs)
+                            checkpoint_every=args.checkpoint_every, name=label, task_kwargs=args.task_kwargs,
+                            layout=args.layout)
         if args.resume and os.path.exists(run.checkpoint_path):
             run.restore()  # raises on damaged/mismatched checkpoints, never restarts silently
         runs[label] = run
@@ -387,7 +395,7 @@ def main(argv=None):
                     os.unlink(p)
     evaluation.write_json(os.path.join(args.out, "config.json"), {
         "argv": sys.argv if argv is None else list(argv), "config": config.to_dict(),
-        "task_kwargs": args.task_kwargs,
+        "task_kwargs": args.task_kwargs, "layout": args.layout,
         "plans": {k: format_plan(v) for k, v in run_plans.items()}, "seed": args.seed})
 
     out_eval = os.path.join(args.out, "evaluation")

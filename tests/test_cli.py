@@ -4,6 +4,7 @@ Success: status 0, no traceback and no dumped return value on stderr.  An
 expected user error: non-zero status and one line `robostrich-X: error: ...`
 (after argparse's usage lines for a usage error), no traceback.
 """
+import json
 import os
 import shutil
 import subprocess
@@ -12,6 +13,7 @@ import sys
 import pytest
 
 from agents import checkpoint
+from robostrich_suite import layouts, targets
 
 TINY_TRAIN = ["--plan", "lesson1:250", "--no-baseline", "--hidden", "16,16", "--batch-size", "16",
               "--min-replay", "50", "--num-eval-targets", "1", "--final-eval-targets", "1", "--quiet",
@@ -96,6 +98,25 @@ def test_evaluate_exits_zero_on_a_checkpoint(trained, tmp_path):
     assert (tmp_path / "ev" / "summary.json").stat().st_size > 0
 
 
+def test_train_runs_on_the_quadruped_and_on_another_layout(tmp_path):
+    """issue 10: a plan on robostrich_a1 no longer falls through to dm_control; --layout names a layout."""
+    processes = {"a1": start("robostrich-train", *TINY_TRAIN, "--domain", "robostrich_a1", "--out", tmp_path / "a1"),
+                 "layout": start("robostrich-train", *TINY_TRAIN, "--layout", "antagonist_pairs",
+                                 "--out", tmp_path / "layout")}
+    results = {name: finish(process) for name, process in processes.items()}
+    for name, result in results.items():
+        assert_succeeded(result)
+        summary = json.loads((tmp_path / name / "summary.json").read_text())["runs"]
+        assert set(summary) == {"curriculum", "lookup"}
+        assert summary["lookup"]["heldout"]["episodes"] == 1 and "heldout_moving" in summary["curriculum"]
+    a1 = json.loads((tmp_path / "a1" / "evaluation" / "curriculum_heldout.json").read_text())
+    assert a1["domain"] == "robostrich_a1" and "track" not in json.loads(
+        (tmp_path / "a1" / "summary.json").read_text())["runs"]["curriculum"]
+    layout = json.loads((tmp_path / "layout" / "evaluation" / "lookup_heldout.json").read_text())
+    assert layout["layout"] == "antagonist_pairs"
+    assert layout["episodes"][0]["target"] == targets.heldout_targets(layouts.target_file("antagonist_pairs"))[0].tolist()
+
+
 def test_the_other_scripts_exit_zero(tmp_path):
     runs = {  # cheap real invocations, run side by side
         "robostrich-export-xml": ["--out", tmp_path / "xml"],
@@ -126,6 +147,8 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
                            "--no-figures"),
         "empty": start("robostrich-evaluate", tmp_path / "empty.pkl", "--num-targets", "1"),
         "ramp_negative": start("robostrich-movement", "--ramp-time", "-1", "--out", tmp_path / "mv"),
+        "layout": start("robostrich-train", "--layout", "tangled", "--quiet", "--out", tmp_path / "lay"),
+        "task": start("robostrich-train", "--plan", "lesson1:10,lesson9:10", "--quiet", "--out", tmp_path / "task"),
     }
     results = {case: finish(p) for case, p in cases.items()}
     assert_user_error(results["resume_empty"], "--resume", "no checkpoint", str(empty))
@@ -136,7 +159,10 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     assert_user_error(results["empty"], "empty.pkl", "not a robostrich SAC checkpoint")
     assert_user_error(results["ramp_negative"], "ramp_time")
     assert not list(tmp_path.glob("mv/*.rrd"))  # refused before the recording was opened
-    for case in ("resume_empty", "truncated", "empty", "ramp_negative"):
+    assert_user_error(results["layout"], "unknown layout 'tangled'")
+    assert_user_error(results["task"], "no task 'lesson9'")
+    assert not (tmp_path / "lay").exists() and not (tmp_path / "task").exists()
+    for case in ("resume_empty", "truncated", "empty", "ramp_negative", "layout", "task"):
         assert results[case].returncode == 2, (case, results[case].stderr)
 
 

@@ -20,7 +20,8 @@ class SACBuilder:
     def __init__(self, config: SACConfig):
         self.config = config
 
-    def make_components(self, env, seed: int):
+    def make_components(self, env, seed: int, lookup_table=None):
+        """`lookup_table`: the residual policy's base (agents/lookup.py; default: the paper layout's poses)."""
         cfg = self.config
         action_spec = env.action_spec()
         if len(action_spec.shape) != 1:
@@ -28,7 +29,7 @@ class SACBuilder:
         flattener = ObservationFlattener(env.observation_spec())
         if cfg.residual_scale > 0:
             from agents.lookup import LookupPolicy
-            adapter = ResidualAdapter(action_spec, LookupPolicy(flattener), cfg.residual_scale)
+            adapter = ResidualAdapter(action_spec, LookupPolicy(flattener, lookup_table), cfg.residual_scale)
         else:
             adapter = ActionAdapter(action_spec)
         networks = make_networks(flattener.size, adapter.size, cfg.hidden_sizes, cfg.log_std_min, cfg.log_std_max,

@@ -1,0 +1,163 @@
+"""What the agent layer needs to know about a domain, in one place.
+
+The curriculum, the evaluation and the training CLI ask a `Domain` for an
+environment, the held-out targets, the lookup table and which evaluations
+exist, instead of testing domain names themselves.  Every domain in
+``robostrich_suite.TASKS_BY_DOMAIN`` is an arm domain (``robostrich`` on the
+frame, ``robostrich_a1`` on the quadruped, targets in its trunk frame); any
+other name is a dm_control suite domain, scored by episode returns.
+
+An arm domain may name a built-in tendon layout (``robostrich_suite.layouts``):
+its lessons then use that layout and its shipped level poses, and the
+held-out targets and the lookup table come from the same file, so an agent
+trained on ``antagonist_pairs`` is judged on that layout's targets.
+"""
+import dataclasses
+from typing import Optional, Tuple
+
+import numpy as np
+
+# Tasks on an arm domain whose episodes start from the fixed pose (held-out
+# evaluation) and continue from the last state (moving starts).
+HELDOUT_TASK = "lesson2"
+MOVING_START_TASK = "lesson3"
+TRACK_TASK = "track"
+
+
+def arm_domains() -> Tuple[str, ...]:
+    import robostrich_suite
+    return tuple(robostrich_suite.TASKS_BY_DOMAIN)
+
+
+@dataclasses.dataclass(frozen=True)
+class Domain:
+    """A domain name plus, on the arm, an optional built-in tendon layout."""
+    name: str
+    layout: Optional[str] = None
+
+    def __post_init__(self):
+        if self.layout is not None:
+            if not self.is_arm:
+                raise ValueError(f"--layout applies to the arm domains {list(arm_domains())}, "
+                                 f"not to {self.name!r}")
+            from robostrich_suite import layouts
+            if self.layout not in layouts.BUILT_IN:
+                raise ValueError(f"unknown layout {self.layout!r}; built-in layouts are "
+                                 f"{list(layouts.BUILT_IN)}")
+            layouts.target_file(self.layout)  # FileNotFoundError naming the layouts that ship targets
+
+    # -- what kind of domain -----------------------------------------------------------------
+    @property
+    def is_arm(self) -> bool:
+        """A robostrich_suite domain: head errors, held-out targets, the lookup baseline."""
+        return self.name in arm_domains()
+
+    def tasks(self) -> Tuple[str, ...]:
+        if self.is_arm:
+            import robostrich_suite
+            return tuple(robostrich_suite.TASKS_BY_DOMAIN[self.name])
+        from dm_control import suite
+        return tuple(task for domain, task in suite.ALL_TASKS if domain == self.name)
+
+    def check_task(self, task: str) -> None:
+        """ValueError naming the problem if this domain has no task `task`."""
+        tasks = self.tasks()
+        if not tasks:
+            from dm_control import suite
+            raise ValueError(f"unknown domain {self.name!r}: robostrich_suite has {list(arm_domains())}, "
+                             f"dm_control.suite has {sorted({d for d, _ in suite.ALL_TASKS})}")
+        if task not in tasks:
+            raise ValueError(f"domain {self.name!r} has no task {task!r}; its tasks are {list(tasks)}")
+
+    @property
+    def on_quadruped(self) -> bool:
+        return self.name == "robostrich_a1"
+
+    # -- environments ------------------------------------------------------------------------
+    def _target_file(self):
+        from robostrich_suite import layouts, targets
+        return targets.DATA_PATH if self.layout is None else layouts.target_file(self.layout)
+
+    def _to_domain_frame(self, frame_targets) -> np.ndarray:
+        """Targets of the frame arm in this domain's coordinates (the trunk frame on the quadruped)."""
+        frame_targets = np.asarray(frame_targets, np.float64)
+        if self.on_quadruped:
+            from robostrich_suite import robostrich_a1
+            return robostrich_a1.frame_to_trunk(frame_targets)
+        return frame_targets
+
+    def layout_kwargs(self, task: str) -> dict:
+        """The task kwargs a layout implies: the layout, and its own training (or `track`) targets."""
+        if self.layout is None:
+            return {}
+        from robostrich_suite import layouts, reach, targets
+        kwargs = {"tendon_layout": layouts.build(self.layout)}
+        if task == TRACK_TASK:
+            kwargs["targets"] = reach.default_track_targets(self.heldout_targets())
+        elif task.startswith("lesson"):  # head_stabilize and narrow_gap have their own targets
+            kwargs["target_pool"] = self._to_domain_frame(targets.training_targets(self._target_file()))
+        return kwargs
+
+    def make_environment(self, task: str, seed: int, **task_kwargs):
+        """robostrich_suite.load for the arm (with the layout's kwargs), dm_control.suite.load otherwise."""
+        task_kwargs = {"random": seed, **self.layout_kwargs(task), **task_kwargs}
+        if self.is_arm:
+            import robostrich_suite
+            return robostrich_suite.load(self.name, task, task_kwargs=task_kwargs)
+        from dm_control import suite
+        return suite.load(self.name, task, task_kwargs=task_kwargs)
+
+    # -- evaluation --------------------------------------------------------------------------
+    def heldout_task(self, final_task: str) -> str:
+        """lesson2 on the arm (eq. 10 from the fixed pose, so every target starts alike); else the final task."""
+        return HELDOUT_TASK if self.is_arm else final_task
+
+    def track_task(self, requested: Optional[str] = TRACK_TASK) -> Optional[str]:
+        """`requested` where this domain has it (the frame arm's `track`), else None."""
+        return requested if requested and self.is_arm and requested in self.tasks() else None
+
+    @property
+    def has_moving_starts(self) -> bool:
+        return self.is_arm and MOVING_START_TASK in self.tasks()
+
+    def heldout_targets(self, num_targets: Optional[int] = None) -> Optional[np.ndarray]:
+        """The layout's held-out targets in this domain's frame; None (seeded episodes) off the arm."""
+        if not self.is_arm:
+            return None
+        from robostrich_suite import targets
+        pool = self._to_domain_frame(targets.heldout_targets(self._target_file()))
+        return pool if num_targets is None else pool[:num_targets]
+
+    def lookup_table(self) -> Optional[dict]:
+        """The lookup baseline's stored poses for this layout (agents/lookup.py), positions in this
+        domain's frame; None off the arm."""
+        if not self.is_arm:
+            return None
+        from agents.lookup import lookup_table
+        from robostrich_suite import targets
+        path = self._target_file()
+        table = lookup_table(targets.level_head_poses(path), targets.heldout_targets(path))
+        table["head_position"] = self._to_domain_frame(table["head_position"])
+        return table
+
+    def moving_starts(self, count: int = 3):
+        """Start poses of `heldout_moving`: `count` well separated training targets (picked as `track`
+        picks its targets) and the stored inputs that hold them (never a held-out pose)."""
+        from agents.lookup import nearest
+        from robostrich_suite import reach, targets
+        table = self.lookup_table()
+        starts = reach.default_track_targets(
+            self._to_domain_frame(targets.training_targets(self._target_file())), count)
+        return starts, np.stack([table["control"][nearest(table, s)] for s in starts])
+
+    def describe(self) -> str:
+        return self.name if self.layout is None else f"{self.name} (layout {self.layout})"
+
+
+def as_domain(domain, layout: Optional[str] = None) -> Domain:
+    """A `Domain` from a name (or pass one through)."""
+    if isinstance(domain, Domain):
+        if layout is not None and layout != domain.layout:
+            raise ValueError(f"domain {domain.describe()} already names a layout, not {layout!r}")
+        return domain
+    return Domain(str(domain), layout)

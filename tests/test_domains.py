@@ -1,0 +1,90 @@
+"""The domain adapter (agents/domains.py): each arm domain and tendon layout trains and is judged on its own
+targets, with its own lookup table; dm_control domains keep working; bad names are errors that name them."""
+import numpy as np
+import pytest
+
+from agents import checkpoint
+from agents.curriculum import CurriculumRun, parse_plan
+from agents.domains import Domain
+from agents.sac.config import SACConfig
+from robostrich_suite import layouts, reach, robostrich_a1, targets
+
+LAYOUT = "antagonist_pairs"
+TINY = SACConfig(hidden_sizes=(16, 16), batch_size=16, min_replay_size=20, updates_per_call=2,
+                 env_steps_per_call=2)
+
+
+def test_quadruped_domain_reads_the_frame_arms_targets_and_lookup_in_its_trunk_frame():
+    domain = Domain("robostrich_a1")
+    np.testing.assert_allclose(domain.heldout_targets(), robostrich_a1.frame_to_trunk(targets.heldout_targets()))
+    table, frame_table = domain.lookup_table(), Domain("robostrich").lookup_table()
+    np.testing.assert_array_equal(table["control"], frame_table["control"])
+    np.testing.assert_allclose(table["head_position"], robostrich_a1.frame_to_trunk(frame_table["head_position"]))
+    assert domain.heldout_task("lesson4") == "lesson2" and domain.has_moving_starts
+    assert domain.track_task("track") is None  # the quadruped has no `track`; the frame arm has
+    assert Domain("robostrich").track_task("track") == "track"
+    starts, controls = domain.moving_starts()
+    assert starts.shape == (3, 2) and controls.shape == (3, 9)
+    # the starts lie among the quadruped's own training targets (trunk frame), not the frame's
+    pool = robostrich_a1.default_target_pool()
+    assert np.min(np.linalg.norm(pool[None] - starts[:, None], axis=2), axis=1).max() < 1e-12
+
+
+def test_a_layout_trains_and_is_judged_on_its_own_targets():
+    domain = Domain("robostrich", LAYOUT)
+    path = layouts.target_file(LAYOUT)
+    heldout = domain.heldout_targets()
+    np.testing.assert_array_equal(heldout, targets.heldout_targets(path))
+    assert not np.array_equal(heldout[:len(targets.heldout_targets())], targets.heldout_targets())
+    env = domain.make_environment("lesson2", 0)
+    np.testing.assert_array_equal(env.task.target_pool, targets.training_targets(path))
+    track = domain.make_environment("track", 0)
+    np.testing.assert_array_equal(track.task.targets, reach.default_track_targets(heldout))
+    table = domain.lookup_table()
+    assert np.linalg.norm(table["head_position"][:, None] - heldout[None], axis=2).min() >= 0.01  # no held-out pose
+
+    # The table's inputs are this layout's: held from the fixed start they bring the head to the stored pose.
+    env.task.target_pool = table["head_position"][:1]
+    timestep = env.reset()
+    while not timestep.last():
+        timestep = env.step(table["control"][0])
+    assert env.task.position_error(env.physics) < 0.01
+    assert abs(env.task.attitude_error(env.physics)) < 5.0
+
+
+def test_bad_domain_layout_and_task_names_are_errors_that_name_them():
+    with pytest.raises(ValueError, match="unknown layout 'tangled'.*antagonist_pairs"):
+        Domain("robostrich", "tangled")
+    with pytest.raises(ValueError, match="arm domains.*'reacher'"):
+        Domain("reacher", "paper")
+    with pytest.raises(ValueError, match="no task 'lesson9'.*lesson1"):
+        Domain("robostrich").check_task("lesson9")
+    with pytest.raises(ValueError, match="unknown domain 'robostrch'.*robostrich"):
+        Domain("robostrch").check_task("lesson1")
+    Domain("robostrich_a1").check_task("lesson4")
+    Domain("reacher").check_task("easy")
+    assert Domain("reacher").heldout_targets() is None and Domain("reacher").lookup_table() is None
+
+
+def test_curriculum_runs_every_lesson_on_the_quadruped_and_carries_the_learner(tmp_path):
+    plan = parse_plan("lesson1:60,lesson2:60,lesson3:60,lesson4:60", default_domain="robostrich_a1")
+    run = CurriculumRun(plan, TINY, 0, str(tmp_path / "a1"), checkpoint_every=10 ** 6)
+    learner = run.loop.learner
+    run.run()
+    assert run.done and run.loop.env_steps == 240
+    assert run.loop.learner is learner and learner.num_updates > 100
+    assert len(run.loop.replay) == 240  # one replay through all four lessons
+    assert run.loop.env.physics.trunk_height() > 0.1  # the last lesson's environment is the quadruped's
+    assert run.loop.env.task.legs == "walk"  # lesson 4: the quadruped trots
+
+
+def test_a_layout_is_part_of_the_checkpoint(tmp_path):
+    plan = parse_plan("lesson1:40")
+    run = CurriculumRun(plan, TINY, 0, str(tmp_path / "run"), layout=LAYOUT)
+    assert run.fingerprint()["layout"] == LAYOUT
+    run.run()
+    other = CurriculumRun(plan, TINY, 0, str(tmp_path / "other"))  # the paper's layout
+    with pytest.raises(checkpoint.CheckpointError, match="layout"):
+        other.restore(run.checkpoint_path)
+    with pytest.raises(ValueError, match="arm domains"):
+        CurriculumRun(parse_plan("reacher/easy:10"), TINY, 0, str(tmp_path / "r"), layout=LAYOUT)
