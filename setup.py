@@ -34,11 +34,12 @@ setup(
         "console_scripts": [
             "robostrich-train = agents.training:cli",
             "robostrich-evaluate = agents.evaluation:cli",
-            "robostrich-walk = robostrich_suite.walk:cli",
+            "robostrich-walk = robostrich_suite.studies.walk:cli",
             "robostrich-export-xml = robostrich_suite.xml_export:cli",
-            "robostrich-movement = robostrich_suite.movement:cli",
-            "robostrich-workspace = robostrich_suite.workspace:cli",
-            "robostrich-layouts = robostrich_suite.layout_compare:cli",
+            "robostrich-movement = robostrich_suite.studies.movement:cli",
+            "robostrich-workspace = robostrich_suite.studies.workspace:cli",
+            "robostrich-layouts = robostrich_suite.studies.layout_compare:cli",
+            "robostrich-targets = robostrich_suite.studies.target_generation:cli",
         ],
     },
 )

@@ -7,7 +7,7 @@ exist, instead of testing domain names themselves.  Every domain in
 frame, ``robostrich_a1`` on the quadruped, targets in its trunk frame); any
 other name is a dm_control suite domain, scored by episode returns.
 
-An arm domain may name a built-in tendon layout (``robostrich_suite.layouts``):
+An arm domain may name a built-in tendon layout (``robostrich_suite.model.layouts``):
 its lessons then use that layout and its shipped level poses, and the
 held-out targets and the lookup table come from the same file, so an agent
 trained on ``antagonist_pairs`` is judged on that layout's targets.
@@ -40,7 +40,7 @@ class Domain:
             if not self.is_arm:
                 raise ValueError(f"--layout applies to the arm domains {list(arm_domains())}, "
                                  f"not to {self.name!r}")
-            from robostrich_suite import layouts
+            from robostrich_suite.model import layouts
             if self.layout not in layouts.BUILT_IN:
                 raise ValueError(f"unknown layout {self.layout!r}; built-in layouts are "
                                  f"{list(layouts.BUILT_IN)}")
@@ -75,22 +75,25 @@ class Domain:
 
     # -- environments ------------------------------------------------------------------------
     def _target_file(self):
-        from robostrich_suite import layouts, targets
+        from robostrich_suite.model import layouts
+        from robostrich_suite import targets
         return targets.DATA_PATH if self.layout is None else layouts.target_file(self.layout)
 
     def _to_domain_frame(self, frame_targets) -> np.ndarray:
         """Targets of the frame arm in this domain's coordinates (the trunk frame on the quadruped)."""
         frame_targets = np.asarray(frame_targets, np.float64)
         if self.on_quadruped:
-            from robostrich_suite import robostrich_a1
-            return robostrich_a1.frame_to_trunk(frame_targets)
+            from robostrich_suite.tasks import quadruped_tasks
+            return quadruped_tasks.frame_to_trunk(frame_targets)
         return frame_targets
 
     def layout_kwargs(self, task: str) -> dict:
         """The task kwargs a layout implies: the layout, and its own training (or `track`) targets."""
         if self.layout is None:
             return {}
-        from robostrich_suite import layouts, reach, targets
+        from robostrich_suite.model import layouts
+        from robostrich_suite.tasks import reach
+        from robostrich_suite import targets
         kwargs = {"tendon_layout": layouts.build(self.layout)}
         if task == TRACK_TASK:
             kwargs["targets"] = reach.default_track_targets(self.heldout_targets())
@@ -144,7 +147,8 @@ class Domain:
         """Start poses of `heldout_moving`: `count` well separated training targets (picked as `track`
         picks its targets) and the stored inputs that hold them (never a held-out pose)."""
         from agents.lookup import nearest
-        from robostrich_suite import reach, targets
+        from robostrich_suite.tasks import reach
+        from robostrich_suite import targets
         table = self.lookup_table()
         starts = reach.default_track_targets(
             self._to_domain_frame(targets.training_targets(self._target_file())), count)

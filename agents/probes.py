@@ -6,15 +6,15 @@ of the desired attitude (90 deg = level) at the end of an episode.
 import numpy as np
 
 # The paper's tolerances and desired attitude, defined once by the tasks.
-from robostrich_suite.reach import ATTITUDE_TOLERANCE, POSITION_TOLERANCE  # noqa: F401
-from robostrich_suite.reach import DESIRED_ATTITUDE as LEVEL_ATTITUDE  # noqa: F401
+from robostrich_suite.tasks.reach import ATTITUDE_TOLERANCE, POSITION_TOLERANCE  # noqa: F401
+from robostrich_suite.tasks.reach import DESIRED_ATTITUDE as LEVEL_ATTITUDE  # noqa: F401
 
 
 def head_errors(env):
     """(position error m, |attitude error| deg) of the current state; NaN where the env cannot tell.
 
     robostrich: the task's own `position_error(physics)` / `attitude_error(physics)`
-    (robostrich_suite.reach.Reach). dm_control's point_mass is supported for
+    (robostrich_suite.tasks.reach.Reach). dm_control's point_mass is supported for
     development (attitude error 0).
     """
     physics, task = env.physics, env.task

@@ -9,7 +9,6 @@ dm_control's own registry does not know about).
 from __future__ import annotations
 
 import collections
-import inspect
 import os
 
 
@@ -49,27 +48,15 @@ def _renderer_error(error: BaseException) -> ImportError:
 
 
 try:
-    from robostrich_suite import robostrich  # noqa: E402  (after the renderer choice: it imports dm_control)
+    # After the renderer choice: the domains import dm_control.
+    from robostrich_suite import robostrich, robostrich_a1  # noqa: E402
 except (ImportError, AttributeError, OSError) as _error:
     import traceback
     if any("_render" in frame.filename for frame in traceback.extract_tb(_error.__traceback__)):
         raise _renderer_error(_error) from _error
     raise
 
-_DOMAINS = collections.OrderedDict(
-    (name, module) for name, module in [("robostrich", robostrich)])
-
-
-def _register_optional_domains():
-    """Domains that live in modules of their own register here when importable."""
-    try:
-        from robostrich_suite import robostrich_a1
-    except ImportError:
-        return
-    _DOMAINS["robostrich_a1"] = robostrich_a1
-
-
-_register_optional_domains()
+_DOMAINS = collections.OrderedDict([("robostrich", robostrich), ("robostrich_a1", robostrich_a1)])
 
 ALL_TASKS = tuple((domain, task) for domain, module in _DOMAINS.items()
                   for task in module.SUITE)
@@ -113,10 +100,4 @@ def load(domain_name, task_name, task_kwargs=None, environment_kwargs=None, visu
     task_kwargs = dict(task_kwargs or {})
     if environment_kwargs is not None:
         task_kwargs["environment_kwargs"] = environment_kwargs
-    factory = domain.SUITE[task_name]
-    accepted = inspect.signature(factory).parameters
-    if not any(p.kind == p.VAR_KEYWORD for p in accepted.values()):
-        unknown = set(task_kwargs) - set(accepted)
-        if unknown:
-            raise ValueError(f"{domain_name}/{task_name} does not take {sorted(unknown)}")
-    return factory(**task_kwargs)
+    return domain.SUITE[task_name](**task_kwargs)

@@ -117,9 +117,3 @@ def log_path(rec: rr.RecordingStream, entity: str, points, color=(255, 60, 60)) 
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     if len(points) >= 2:
         rec.log(entity, rr.LineStrips3D([points], colors=[color]))
-
-
-def log_targets(rec: rr.RecordingStream, entity: str, points, radius: float = 0.01,
-                color=(40, 200, 40), static: bool = True) -> None:
-    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    rec.log(entity, rr.Points3D(points, radii=radius, colors=[color]), static=static)

@@ -24,14 +24,7 @@ def _robostrich_a1():
 
 def generators() -> dict:
     """File name -> function returning that model's XML string."""
-    models = {"robostrich.xml": _robostrich}
-    try:
-        import robostrich_suite.robostrich_a1  # noqa: F401
-    except ImportError:
-        pass
-    else:
-        models["robostrich_a1.xml"] = _robostrich_a1
-    return models
+    return {"robostrich.xml": _robostrich, "robostrich_a1.xml": _robostrich_a1}
 
 
 def export(directory: pathlib.Path = REPO_XML_DIR) -> list[pathlib.Path]:

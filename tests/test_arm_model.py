@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 from dm_control import mjcf
 
-from robostrich_suite import arm, table1, xml_export
+from robostrich_suite import physics as physics_lib
+from robostrich_suite import xml_export
+from robostrich_suite.model import arm, scenes, table1
 from robostrich_suite.robostrich import Physics, get_model_and_assets
 
 
@@ -115,7 +117,7 @@ def test_generator_takes_another_spec_and_layout():
         arm.TendonSpec("back", "dorsal", ("n4", "n3", "n2", "head")),
         arm.TendonSpec("front_low", "ventral", ("n4", "n3")),
         arm.TendonSpec("front_high", "ventral", ("n4", "n2"))))  # skips the n3 hole
-    physics = mjcf.Physics.from_mjcf_model(arm.build_frame_arm(spec, layout))
+    physics = mjcf.Physics.from_mjcf_model(scenes.build_frame_arm(spec, layout))
     assert (physics.model.njnt, physics.model.nu) == (4, 3)
     assert physics.model.tendon_num.tolist() == [5, 3, 3]  # anchor + holes
 
@@ -180,7 +182,7 @@ def test_tendon_tied_between_vertebrae_acts_only_on_its_own_joints():
     slip = arm.TendonSpec.spanning("slip", "ventral", "c6", spec, origin="c10")
     assert not slip.on_base and slip.links == ("c10", "c9", "c8", "c7", "c6")
     layout = arm.TendonLayout((arm.TendonSpec.spanning("dorsal", "dorsal", "atlas", spec), slip))
-    physics = mjcf.Physics.from_mjcf_model(arm.build_frame_arm(spec, layout))
+    physics = mjcf.Physics.from_mjcf_model(scenes.build_frame_arm(spec, layout))
     assert physics.model.tendon_num.tolist() == [19, 5]  # base anchor + 18 holes; 5 holes
     assert _tendon_joints(physics, "arm/slip") == {"c9", "c8", "c7", "c6"}
     assert len(_tendon_joints(physics, "arm/dorsal")) == 18
@@ -206,7 +208,7 @@ def test_ventral_slips_layout():
     slips = layout.tendons[1:]
     assert [t.links[0] for t in slips] == ["c18", "c18", "c16", "c14", "c12", "c10", "c8", "c6"]
     assert [t.on_base for t in slips] == [True, True] + [False] * 6  # c18 is the base link
-    physics = mjcf.Physics.from_mjcf_model(arm.build_frame_arm(spec, layout))
+    physics = mjcf.Physics.from_mjcf_model(scenes.build_frame_arm(spec, layout))
     assert _tendon_joints(physics, "arm/ventral_c8") == {"c11", "c10", "c9", "c8"}
     with pytest.raises(ValueError, match="span must be a positive"):
         arm.TendonLayout.ventral_slips(spec, span=0)
@@ -221,12 +223,12 @@ def test_tendon_sides_come_from_the_model_not_the_names():
         arm.TendonSpec.spanning("v2", "ventral", "c8", spec),
         arm.TendonSpec.spanning("pull_back", "dorsal", spec.head_name, spec),
     ))
-    model = mjcf.Physics.from_mjcf_model(arm.build_frame_arm(spec, layout)).model
-    assert arm.tendon_sides(model) == ["ventral", "ventral", "dorsal"]
-    assert arm.dorsal_index(model) == 2
-    assert arm.ventral_indices(model) == [0, 1]
+    model = mjcf.Physics.from_mjcf_model(scenes.build_frame_arm(spec, layout)).model
+    assert physics_lib.tendon_sides(model) == ["ventral", "ventral", "dorsal"]
+    assert physics_lib.dorsal_index(model) == 2
+    assert physics_lib.ventral_indices(model) == [0, 1]
     default = Physics.from_xml_string(*get_model_and_assets()).model
-    assert arm.dorsal_index(default) == 0 and arm.ventral_indices(default) == list(range(1, 9))
+    assert physics_lib.dorsal_index(default) == 0 and physics_lib.ventral_indices(default) == list(range(1, 9))
 
 
 def test_arm_indices_name_what_they_find():
@@ -236,7 +238,7 @@ def test_arm_indices_name_what_they_find():
     for physics in (Physics.from_xml_string(*get_model_and_assets()),
                     robostrich_a1.Physics.from_xml_string(*robostrich_a1.get_model_and_assets())):
         model = physics.model
-        indices = arm.arm_indices(model)
+        indices = physics_lib.arm_indices(model)
         assert [model.id2name(int(j), "joint") for j in indices.joints] == [
             f"arm/{n}" for n in arm.ArmSpec.from_table1().joint_names]
         assert [model.id2name(int(a), "actuator") for a in indices.actuators] == [

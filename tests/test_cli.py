@@ -13,7 +13,8 @@ import sys
 import pytest
 
 from agents import checkpoint
-from robostrich_suite import layouts, targets
+from robostrich_suite import targets
+from robostrich_suite.model import layouts
 
 TINY_TRAIN = ["--plan", "lesson1:250", "--no-baseline", "--hidden", "16,16", "--batch-size", "16",
               "--min-replay", "50", "--num-eval-targets", "1", "--final-eval-targets", "1", "--quiet",

@@ -7,7 +7,9 @@ from agents import checkpoint
 from agents.curriculum import CurriculumRun, parse_plan
 from agents.domains import Domain
 from agents.sac.config import SACConfig
-from robostrich_suite import layouts, reach, robostrich_a1, targets
+from robostrich_suite import targets
+from robostrich_suite.model import layouts
+from robostrich_suite.tasks import quadruped_tasks, reach
 
 LAYOUT = "antagonist_pairs"
 TINY = SACConfig(hidden_sizes=(16, 16), batch_size=16, min_replay_size=20, updates_per_call=2,
@@ -16,17 +18,17 @@ TINY = SACConfig(hidden_sizes=(16, 16), batch_size=16, min_replay_size=20, updat
 
 def test_quadruped_domain_reads_the_frame_arms_targets_and_lookup_in_its_trunk_frame():
     domain = Domain("robostrich_a1")
-    np.testing.assert_allclose(domain.heldout_targets(), robostrich_a1.frame_to_trunk(targets.heldout_targets()))
+    np.testing.assert_allclose(domain.heldout_targets(), quadruped_tasks.frame_to_trunk(targets.heldout_targets()))
     table, frame_table = domain.lookup_table(), Domain("robostrich").lookup_table()
     np.testing.assert_array_equal(table["control"], frame_table["control"])
-    np.testing.assert_allclose(table["head_position"], robostrich_a1.frame_to_trunk(frame_table["head_position"]))
+    np.testing.assert_allclose(table["head_position"], quadruped_tasks.frame_to_trunk(frame_table["head_position"]))
     assert domain.heldout_task("lesson4") == "lesson2" and domain.has_moving_starts
     assert domain.track_task("track") is None  # the quadruped has no `track`; the frame arm has
     assert Domain("robostrich").track_task("track") == "track"
     starts, controls = domain.moving_starts()
     assert starts.shape == (3, 2) and controls.shape == (3, 9)
     # the starts lie among the quadruped's own training targets (trunk frame), not the frame's
-    pool = robostrich_a1.default_target_pool()
+    pool = quadruped_tasks.default_target_pool()
     assert np.min(np.linalg.norm(pool[None] - starts[:, None], axis=2), axis=1).max() < 1e-12
 
 

@@ -9,7 +9,8 @@ import pytest
 from agents import evaluation, figures
 from agents.replay import ObservationFlattener
 from agents.curriculum import make_environment
-from robostrich_suite import movement, robostrich_a1, walk
+from robostrich_suite.studies import movement, walk
+from robostrich_suite.tasks import quadruped_tasks
 
 
 class ZeroTendons:
@@ -91,9 +92,9 @@ def test_walk_draws_the_target_p_d_and_the_trunk_height_on_its_own_scale(walk_se
         titles = _panel_titles(fig, 5)
         assert [t[:3] for t in titles] == ["(A)", "(B)", "(C)", "(D)", "(E)"]
         target = _line(fig.axes[3], "target $P_d$")
-        np.testing.assert_allclose(target.get_ydata(), robostrich_a1.HEAD_STABILIZE_DISTANCE)
+        np.testing.assert_allclose(target.get_ydata(), quadruped_tasks.HEAD_STABILIZE_DISTANCE)
         np.testing.assert_allclose(_line(fig.axes[0], "target head height").get_ydata(),
-                                   robostrich_a1.HEAD_STABILIZE_HEIGHT)
+                                   quadruped_tasks.HEAD_STABILIZE_HEIGHT)
         trunk_axes = [ax for ax in fig.axes if "trunk height" in _legend_labels(ax)]
         assert len(trunk_axes) == 1 and "head height" not in _legend_labels(trunk_axes[0])
     finally:

@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from robostrich_suite import gait, quadruped as quad
+from robostrich_suite.model import quadruped as quad
+from robostrich_suite.tasks import gait
 
 
 def test_leg_ik_inverts_fk_over_the_workspace():

@@ -8,7 +8,9 @@ import sys
 import numpy as np
 import pytest
 
-from robostrich_suite import arm, coverage, layout_compare, layouts, workspace
+from robostrich_suite.model import arm, layouts
+from robostrich_suite.model import fingerprint as fingerprint_lib
+from robostrich_suite.studies import coverage, layout_compare, workspace
 
 
 def xml(layout, spec=None):
@@ -149,7 +151,7 @@ def test_the_better_layout_ships_with_its_own_targets_loadable_through_task_kwar
     from robostrich_suite import targets
     path = layouts.target_file("antagonist_pairs")
     spec = arm.ArmSpec.from_table1()
-    assert str(targets.level_head_poses(path)["fingerprint"]) == workspace.model_fingerprint(
+    assert str(targets.level_head_poses(path)["fingerprint"]) == fingerprint_lib.model_fingerprint(
         spec, layouts.build("antagonist_pairs"))
     assert layouts.target_file("paper") == targets.DATA_PATH  # the tasks' default stays
     env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=layouts.task_kwargs("antagonist_pairs"))

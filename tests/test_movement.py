@@ -12,7 +12,7 @@ paper's difference.  On the tasks' arm (every ventral tendon from the base, dors
 *length* held, ``movement.PAPER_LAYOUT``) the difference does not appear: rolling
 25.0 deg / 190 mm, lever 25.4 deg / 191 mm, because there the settled poses form a
 one-parameter family whose attitude is a function of the head position (tested
-below); numbers and reasons in the docstring of ``robostrich_suite.movement``.
+below); numbers and reasons in docs/movement.md.
 """
 import shutil
 import subprocess
@@ -22,7 +22,7 @@ import pathlib
 import numpy as np
 import pytest
 
-from robostrich_suite import movement
+from robostrich_suite.studies import movement
 
 
 @pytest.fixture(scope="module")

@@ -4,7 +4,9 @@ import pytest
 from dm_control import mjcf
 
 import robostrich_suite
-from robostrich_suite import gait, quadruped as quad, robostrich_a1
+from robostrich_suite import robostrich_a1
+from robostrich_suite.model import quadruped as quad
+from robostrich_suite.tasks import gait
 
 
 @pytest.fixture(scope="module")

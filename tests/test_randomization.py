@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import robostrich_suite
-from robostrich_suite.randomization import DomainRandomization
+from robostrich_suite.tasks.randomization import DomainRandomization
 
 
 def _masses(env):

@@ -6,7 +6,10 @@ from absl.testing import absltest
 from dm_env import test_utils
 
 import robostrich_suite
-from robostrich_suite import gait, quadruped as quad, robostrich_a1 as a1, walk, xml_export
+from robostrich_suite import robostrich_a1 as a1, xml_export
+from robostrich_suite.model import arm, quadruped as quad, scenes
+from robostrich_suite.studies import walk
+from robostrich_suite.tasks import gait, quadruped_tasks
 
 TASKS = ("lesson1", "lesson2", "lesson3", "lesson4", "head_stabilize", "narrow_gap")
 TABLE2 = {"head_position": 3, "head_velocity": 3, "joint_angles": 18, "trunk_position": 3,
@@ -97,7 +100,7 @@ def test_lesson4_trunk_height_changes_over_the_episode():
         if step.last():
             break
     heights = np.array(heights)
-    middle = env.task.height_schedule(a1.LESSON4_TIME_LIMIT / 2)
+    middle = env.task.height_schedule(quadruped_tasks.LESSON4_TIME_LIMIT / 2)
     assert abs(middle - quad.STANDING_TRUNK_HEIGHT) > 0.005
     n = len(heights)
     assert heights[n // 2 - 20: n // 2 + 20].mean() == pytest.approx(middle, abs=0.01)
@@ -131,18 +134,18 @@ def test_standing_lessons_keep_the_quadruped_in_place():
 
 
 def test_lesson_targets_are_the_frame_targets_moved_onto_the_trunk():
-    pool = a1.default_target_pool()
+    pool = quadruped_tasks.default_target_pool()
     assert pool.shape[1] == 2
     env = robostrich_suite.load("robostrich_a1", "lesson1", task_kwargs=dict(random=0))
     env.reset()
     assert any(np.allclose(env.task.target_position, p) for p in pool)
-    np.testing.assert_allclose(a1.frame_to_trunk([[0.0, a1.FRAME_MOUNT_HEIGHT]]),
-                               [[quad.MOUNT_X, a1.NOMINAL_MOUNT_HEIGHT]])
+    np.testing.assert_allclose(quadruped_tasks.frame_to_trunk([[0.0, scenes.FRAME_MOUNT_HEIGHT]]),
+                               [[quad.MOUNT_X, scenes.NOMINAL_MOUNT_HEIGHT]])
     # The arm's base (C18 joint) is where the mapping assumes it, once standing.
     physics = env.physics
     base = physics.to_trunk_frame(physics.arm_base_position())
     assert base[0] == pytest.approx(quad.MOUNT_X, abs=0.005)
-    assert base[2] == pytest.approx(a1.NOMINAL_MOUNT_HEIGHT, abs=0.01)
+    assert base[2] == pytest.approx(scenes.NOMINAL_MOUNT_HEIGHT, abs=0.01)
 
 
 def test_lesson3_continues_from_the_previous_episode():
@@ -175,11 +178,11 @@ def test_narrow_gap_walks_up_to_the_wall_then_stands_and_steps_targets():
     for _ in range(700):  # 5.6 s
         env.step(np.zeros(9))
         indices.append(task.target_index)
-        gaps.append(a1.GAP_WALL_X - physics.arm_base_position()[0])
+        gaps.append(scenes.GAP_WALL_X - physics.arm_base_position()[0])
     assert not task.walking()
     gaps = np.array(gaps)
     # Stopped near the stopping distance, never touching the wall with the trunk.
-    assert gaps[-1] == pytest.approx(a1.GAP_STOP_DISTANCE, abs=0.06)
+    assert gaps[-1] == pytest.approx(quadruped_tasks.GAP_STOP_DISTANCE, abs=0.06)
     assert gaps.min() > 0.05
     assert np.all(np.diff(indices) >= 0) and indices[-1] == 4
     # Targets stay fixed in the world while the robot moves (up to the projection of the
@@ -195,7 +198,7 @@ def _push_head_towards_the_wall(wall_collides: bool):
     if not wall_collides:
         physics.model.geom_contype[walls] = 0
         physics.model.geom_conaffinity[walls] = 0
-    trunk_x = a1.GAP_WALL_X - a1.GAP_STOP_DISTANCE + 0.02 - quad.MOUNT_X
+    trunk_x = scenes.GAP_WALL_X - quadruped_tasks.GAP_STOP_DISTANCE + 0.02 - quad.MOUNT_X
     with physics.reset_context():
         physics.place_standing(trunk_xy=(trunk_x, 0.0))
     low, high = physics.arm_control_range().T
@@ -204,7 +207,7 @@ def _push_head_towards_the_wall(wall_collides: bool):
     physics.set_arm_control(flex)
     head_x, arm_wall_contacts = [], 0
     arm_geoms = {i for i in range(physics.model.ngeom)
-                 if physics.model.id2name(i, "geom").startswith(a1.ARM_PREFIX)}
+                 if physics.model.id2name(i, "geom").startswith(f"{arm.ARM_MODEL_NAME}/")}
     for _ in range(750):
         physics.step()
         head_x.append(physics.head_position()[0])
@@ -217,8 +220,8 @@ def _push_head_towards_the_wall(wall_collides: bool):
 def test_narrow_gap_wall_blocks_the_head():
     blocked, contacts = _push_head_towards_the_wall(True)
     free, free_contacts = _push_head_towards_the_wall(False)
-    assert free.max() > a1.GAP_WALL_X + 0.1  # without the wall the head would go through
-    assert blocked.max() < a1.GAP_WALL_X  # with it, the head stops in front
+    assert free.max() > scenes.GAP_WALL_X + 0.1  # without the wall the head would go through
+    assert blocked.max() < scenes.GAP_WALL_X  # with it, the head stops in front
     assert contacts > 0 and free_contacts == 0
 
 
@@ -238,12 +241,12 @@ def test_checked_in_xml_is_the_generated_model_and_loads_in_plain_mujoco():
 
 def test_scene_name_is_checked():
     with pytest.raises(ValueError, match="unknown scene"):
-        a1.build_model(scene="stairs")
+        scenes.build_a1(scene="stairs")
 
 
 def test_bad_task_options_raise():
     with pytest.raises(ValueError, match="unknown legs"):
-        a1.QuadrupedReach(legs="run")
+        quadruped_tasks.QuadrupedReach(legs="run")
     with pytest.raises(ValueError, match="outside the range"):
         robostrich_suite.load("robostrich_a1", "head_stabilize", task_kwargs=dict(
             trunk_heights=gait.TrunkHeightSchedule((0, 1), (0.27, 0.5))))
@@ -280,7 +283,7 @@ def test_walk_series_show_the_trot_and_the_scripted_nod():
 
 
 def test_shared_arm_accessors_and_domain_randomisation_find_the_arm():
-    from robostrich_suite import randomization
+    from robostrich_suite.tasks import randomization
     env = robostrich_suite.load("robostrich_a1", "lesson2", task_kwargs=dict(
         random=0, randomization=randomization.DomainRandomization(mass_scale=(1.2, 1.3))))
     physics = env.physics

@@ -7,7 +7,9 @@ from absl.testing import absltest
 from dm_env import test_utils
 
 import robostrich_suite
-from robostrich_suite import arm, rewards, targets
+from robostrich_suite import targets
+from robostrich_suite.model import arm
+from robostrich_suite.tasks import rewards
 
 TASKS = robostrich_suite.TASKS_BY_DOMAIN["robostrich"]
 

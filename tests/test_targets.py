@@ -5,18 +5,23 @@ import numpy as np
 import pytest
 
 import robostrich_suite
-from robostrich_suite import arm, targets, workspace
+from robostrich_suite import physics as physics_lib
+from robostrich_suite import targets
+from robostrich_suite.model import arm
+from robostrich_suite.model import fingerprint as fingerprint_lib
+from robostrich_suite.model import scenes
+from robostrich_suite.studies import target_generation, workspace
 
 
 def test_pose_set_was_made_with_the_current_arm():
-    assert str(targets.level_head_poses()["fingerprint"]) == workspace.model_fingerprint(), (
-        "data/level_head_poses.npz is stale: run python -m robostrich_suite.targets")
+    assert str(targets.level_head_poses()["fingerprint"]) == fingerprint_lib.model_fingerprint(), (
+        "data/level_head_poses.npz is stale: run robostrich-targets --out robostrich_suite/data/level_head_poses.npz")
 
 
 def test_poses_are_level_and_split_without_overlap():
     poses = targets.level_head_poses()
     assert len(poses["head_position"]) >= 50
-    assert np.all(np.abs(arm.attitude_error_deg(poses["head_attitude"], 90)) <= 5)
+    assert np.all(np.abs(physics_lib.attitude_error_deg(poses["head_attitude"], 90)) <= 5)
     train, held_out = targets.training_targets(), targets.heldout_targets()
     assert len(train) >= 60 and len(held_out) >= 15
     distances = np.linalg.norm(train[:, None] - held_out[None], axis=2)
@@ -28,11 +33,11 @@ def test_poses_are_level_and_split_without_overlap():
 @pytest.mark.parametrize("index", [0, 21, 1000, 2500])
 def test_stored_inputs_really_hold_the_head_level_there(index):
     poses = targets.level_head_poses()
-    physics = workspace.frame_physics()
+    physics = scenes.frame_physics()
     assert workspace.settle(physics, poses["control"][index])
     np.testing.assert_allclose(workspace.head_position_xz(physics),
                                poses["head_position"][index], atol=1e-6)
-    assert abs(arm.attitude_error_deg(workspace.head_attitude_deg(physics), 90)) <= 5
+    assert abs(physics_lib.attitude_error_deg(workspace.head_attitude_deg(physics), 90)) <= 5
 
 
 def test_another_arm_gets_a_warning_and_its_own_targets(tmp_path):
@@ -46,11 +51,11 @@ def test_another_arm_gets_a_warning_and_its_own_targets(tmp_path):
                               task_kwargs=dict(arm_spec=arm.ArmSpec.from_table1()))
 
     path = tmp_path / "slip_targets.npz"
-    count = targets.generate(12, seed=3, path=path, workers=1, spec=None, layout=slips)
+    count = target_generation.generate(12, seed=3, path=path, workers=1, spec=None, layout=slips)
     with np.load(path) as data:
-        assert str(data["fingerprint"]) == workspace.model_fingerprint(None, slips)
+        assert str(data["fingerprint"]) == fingerprint_lib.model_fingerprint(None, slips)
         assert len(data["head_position"]) == count > 0
-        assert np.all(np.abs(arm.attitude_error_deg(data["head_attitude"], 90)) <= 5)
+        assert np.all(np.abs(physics_lib.attitude_error_deg(data["head_attitude"], 90)) <= 5)
     pool = np.concatenate([targets.training_targets(path), targets.heldout_targets(path)])
     assert len(pool) >= 1
     with warnings.catch_warnings():
@@ -62,13 +67,14 @@ def test_another_arm_gets_a_warning_and_its_own_targets(tmp_path):
 
 
 def test_running_the_module_prints_no_runpy_warning():
-    """`python -m robostrich_suite.targets` (README) without runpy's RuntimeWarning about sys.modules:
-    importing the package must not import the targets module (issue 11)."""
+    """`python -m robostrich_suite.studies.target_generation` without runpy's RuntimeWarning about
+    sys.modules: importing the package must not import the generation module (issue 11)."""
     import os
     import subprocess
     import sys
     env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
-    result = subprocess.run([sys.executable, "-W", "default", "-m", "robostrich_suite.targets", "--help"],
+    result = subprocess.run([sys.executable, "-W", "default", "-m", "robostrich_suite.studies.target_generation",
+                             "--help"],
                             capture_output=True, text=True, env=env, timeout=120)
     assert result.returncode == 0, result.stderr
     assert "RuntimeWarning" not in result.stderr and "Warning" not in result.stderr, result.stderr

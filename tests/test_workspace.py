@@ -2,12 +2,16 @@
 import numpy as np
 import pytest
 
-from robostrich_suite import arm, targets, workspace
+from robostrich_suite import physics as physics_lib
+from robostrich_suite.model import arm
+from robostrich_suite.model import fingerprint as fingerprint_lib
+from robostrich_suite.model import scenes
+from robostrich_suite.studies import target_generation, workspace
 
 
 @pytest.fixture(scope="module")
 def physics():
-    return workspace.frame_physics()
+    return scenes.frame_physics()
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +57,7 @@ def test_blue_set_is_a_level_subset_of_the_red_set(kinematic):
     blue = kinematic.head_position[level]
     red = {tuple(p) for p in kinematic.head_position}
     assert all(tuple(p) in red for p in blue)
-    error = np.abs(arm.attitude_error_deg(kinematic.head_attitude, 90))  # where the head points
+    error = np.abs(physics_lib.attitude_error_deg(kinematic.head_attitude, 90))  # where the head points
     assert np.all(error[level] <= 5)
     assert np.all(error[~level] > 5)
 
@@ -70,7 +74,7 @@ def test_actuated_poses_lie_in_the_kinematic_workspace(actuated, physics):
     assert np.all(angles >= limits[:, 0] - tolerance)
     assert np.all(angles <= limits[:, 1] + tolerance)
     clamped = np.clip(angles, limits[:, 0], limits[:, 1])
-    qpos_adr = arm.arm_indices(physics.model).qpos
+    qpos_adr = physics_lib.arm_indices(physics.model).qpos
     for pose, head in zip(clamped, actuated.head_position[actuated.settled]):
         with physics.reset_context():
             physics.data.qpos[qpos_adr] = pose
@@ -93,7 +97,7 @@ def test_level_seeking_finds_inputs_that_hold_the_head_level(physics):
     for control, head in zip(samples.control[level], samples.head_position[level]):
         assert workspace.settle(physics, control)  # the stored inputs alone, from reset
         np.testing.assert_allclose(workspace.head_position_xz(physics), head, atol=1e-9)
-        assert abs(arm.attitude_error_deg(workspace.head_attitude_deg(physics), 90)) <= 5
+        assert abs(physics_lib.attitude_error_deg(workspace.head_attitude_deg(physics), 90)) <= 5
 
 
 def test_command_line_writes_the_figure_and_the_samples(tmp_path):
@@ -107,16 +111,16 @@ def test_command_line_writes_the_figure_and_the_samples(tmp_path):
         assert data["kinematic_head_position"].shape == (4000, 2)
         assert data["actuated_head_position"].shape == (4, 2)
         assert data["kinematic_level"].dtype == bool
-        assert str(data["fingerprint"]) == workspace.model_fingerprint()
+        assert str(data["fingerprint"]) == fingerprint_lib.model_fingerprint()
 
 
 def test_targets_are_generated_from_the_workspace_sampler(tmp_path):
-    """targets.generate still draws from workspace.actuated_samples (the one source)."""
+    """target_generation.generate still draws from workspace.actuated_samples (the one source)."""
     path = tmp_path / "poses.npz"
-    count = targets.generate(4, seed=5, path=path, workers=1)
+    count = target_generation.generate(4, seed=5, path=path, workers=1)
     with np.load(path) as data:
         assert len(data["head_position"]) == count
-        assert np.all(np.abs(arm.attitude_error_deg(data["head_attitude"], 90)) <= 5)
+        assert np.all(np.abs(physics_lib.attitude_error_deg(data["head_attitude"], 90)) <= 5)
 
 
 @pytest.mark.parametrize("args, message", [

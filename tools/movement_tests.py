@@ -3,10 +3,10 @@ import pathlib
 import sys
 
 try:
-    from robostrich_suite import movement
+    from robostrich_suite.studies import movement
 except ImportError:  # run from a checkout without `pip install -e .`
     sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-    from robostrich_suite import movement
+    from robostrich_suite.studies import movement
 
 if __name__ == "__main__":
     sys.exit(movement.cli())

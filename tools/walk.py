@@ -8,7 +8,7 @@ import sys
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-from robostrich_suite.walk import cli  # noqa: E402
+from robostrich_suite.studies.walk import cli  # noqa: E402
 
 if __name__ == "__main__":
     sys.exit(cli())

@@ -1,102 +1,13 @@
 """The paper's movement tests (Sec. 4.3, Figs. 3-5): rolling and lever patterns.
 
-Scripted tendon inputs on the arm on its immobile frame.  The dorsal tendon is
-held while the ventral tendons are ramped:
-
-* **rolling**: the ventral tendons are contracted one after another, caudal to
-  cranial (C16 first, C2 last), each let go while the next takes over
-  (``release``), so the bend travels cranially along the neck (the rostral loop
-  moves) and the part cranial of it can stay a bar;
-* **lever**: the ventral tendons are contracted simultaneously, to the amplitude
-  at which the head travels as far as in the rolling pattern
-  (``match_lever_amplitude``), so the two are compared at equal head travel.
-
-The default setting, in which the paper's difference shows
-(``python tools/movement_tests.py``, about 50 s):
-
-* ventral *slips* (``TendonLayout.ventral_slips``, ``ventral_span`` = 4): each
-  ventral tendon is tied four joints caudal of its insertion, like the slips of
-  the ostrich's longus colli ventralis, so it bends only its own stretch;
-* "maintaining the dorsal tendon length" read as holding the dorsal servo's
-  *input*, i.e. its commanded length (``dorsal_hold="input"``, -20 mm): the
-  servo is a spring of ``tendon_kp`` = 4000 N/m, so the tendon stretches with the
-  total pull of the ventral tendons, and with it the head's attitude;
-* 2 s per slip.
-
-    pattern  head travel  attitude (start -> end)  attitude range
-    rolling  136 mm       94.3 -> 102.9 deg        23.4 deg
-    lever    137 mm       94.3 -> 150.1 deg        55.8 deg  (all slips to 23.2 mm)
-
-The rolling pattern keeps the attitude range at 0.42 of the lever's: the lever
-curls the head down as every slip pulls at once, while in the wave only one or
-two slips pull at any time.  Neighbouring settings (lever matched each time):
-0.35-0.48 for slips of 3, 4 or 5 joints with the dorsal at -15, -20 or -25 mm;
-0.41-0.47 for ramps of 1-3 s per slip.  Not robust beyond: with stiffer
-joints (6 N m/rad) the ratio is 0.85-3.6, and the rolling head path is 3-5x its
-start-to-end travel (the head rises and falls as each slip takes over).
-
-**The tasks' arm does not show it** (``PAPER_LAYOUT``: every ventral tendon from
-the base, dorsal *length* held by an integral loop on the dorsal input,
-successive contractions, 1 s per tendon; ``--paper-layout``): both patterns
-start at 84.6 deg and end in the same pose, rolling 190 mm / 25.0 deg of range,
-lever 191 mm / 25.4 deg.  Why: the passive joints (1 N m/rad) are weak against
-the neck's weight, so the hanging neck rests with its caudal joints (C18-C11) on
-their ventral limits and, once the ventral tendons pull, its cranial joints on
-their dorsal limits.  A settled pose is then fixed by where along the neck the
-switch from one limit to the other happens (every tendon from the base pulls on
-all joints caudal of its insertion, so the net tendon torque falls monotonically
-from base to head and changes sign once), and the held dorsal length ties the
-attitude to it: over 100 random ventral inputs at the same dorsal length, poses
-within 15 mm of each other differ by a median 0.6 deg of attitude.  Any ventral
-sequence that moves the head the same way therefore turns it the same way.
-Reproduce the 0.6 deg with ``tools/movement_tests.py --paper-layout --pose-family 100``.
-
-Also tried on the tasks' arm, without the difference appearing (rolling vs lever
-attitude range at equal head travel): passive joints of 5 and 20 N m/rad (``--joint-stiffness``;
-e.g. 58.7 vs 48.9 deg at 224 mm for 5 N m/rad); the dorsal tendon anchored on C10
-instead of the base (28.0 vs 24.5 deg at 185 mm); ventral tendons spanning only
-two joints each instead of running from the base (attitude ranges within 10 %).
-
-Why holding the dorsal length pins the attitude: each joint lengthens the dorsal
-tendon by ``hole_offset * theta - c * theta**2`` (``c`` = a b / 2(a + b) for holes
-a and b from the joint, about a link length / 8), so with its length held the sum
-of the joint angles, which *is* the head attitude, is fixed to first order; it
-moves only through the second-order term, i.e. with how much the neck bends in
-both directions.  Checked on random joint angles: the dorsal length change over
-``hole_offset`` is the angle sum minus 0.3-0.4 rad per rad**2 of ``sum theta**2``.
-
-Travelling-wave rolling (each tendon contracted while the previous one is let go,
-so the bend moves instead of accumulating; the lever = all tendons ramped
-together), measured with a 2.5-4 s settle, 7 s of ramps (attitude range over
-head travel, start to end):
-
-    default arm, dorsal length held:  wave caudal->cranial 25.2 deg / 218 mm
-      (60 % of range), cranial->caudal 27.0 deg / 183 mm; lever 14.0 deg /
-      161 mm (50 %), 117 deg / 336 mm (100 %).  The wave follows the same
-      one-parameter family of poses as the lever (``--pose-family``): no
-      difference.
-    default arm, dorsal input held:   wave 48.8 / 180 mm and 47.5 / 177 mm;
-      lever 29.5 / 125 mm (50 %).
-    joints 5 and 20 N m/rad:          the dorsal tendon goes slack and the
-      stiff neck sways on the servos (head path 5-20x the travel); ranges
-      73-185 deg for waves and levers alike.
-    hole_fraction 0.2 or 0.8:         the static poses are still a one-parameter
-      family (attitude differs by 0.5 deg between heads within 15 mm).
-    ventral slips (``--ventral-span K``, ``TendonLayout.ventral_slips``: each ventral
-      tendon tied K joints caudal of its insertion, so it bends only its stretch):
-      dorsal *length* held: the static poses (K = 4, 300 random inputs) now cover a
-      2-D head region (0.05-0.47 m forward, 0.28-0.63 m up), but every settled
-      attitude lies in 80-102 deg: the held length keeps the attitude whatever the
-      pattern (K = 2: wave 12.2 deg / 90 mm, lever 12.5 deg / 408 mm), and for
-      K >= 3 the length hold makes the floppy neck swing (head paths of metres).
-      Dorsal *input* held, the lever's amplitude bisected until its head travel
-      equals the wave's: ratio 0.33-0.60 over K = 3-6, dorsal -0.01 to -0.03 m and
-      joints of 1 or 3 N m/rad, but 0.85-3.6 with 6 N m/rad, and the wave's head
-      path is 3-15x its travel (the head swings each time a slip lets go).
-
-So the difference needs both ingredients: slips (the tasks' arm, whose tendons run
-from the base, shows none) and the dorsal input held (with its length held, the
-attitude stays within about 10 deg whatever the slips do).
+Scripted tendon inputs on the arm on its immobile frame.  The dorsal tendon is held
+while the ventral tendons are ramped: **rolling** contracts them one after another,
+caudal to cranial, so the bend travels along the neck; **lever** contracts them
+together, to the amplitude at which the head travels as far (``match_lever_amplitude``).
+The defaults (:class:`MovementConfig`: ventral slips, dorsal input held) are the setting
+in which the paper's difference shows (rolling keeps the attitude range at 0.42 of the
+lever's); on the tasks' arm (``PAPER_LAYOUT``, ``--paper-layout``) it does not.  The
+measurements, the settings tried and why are in ``docs/movement.md``.
 """
 from __future__ import annotations
 
@@ -108,9 +19,11 @@ import time
 import numpy as np
 from dm_control import mjcf
 
-from robostrich_suite import arm as arm_lib
-from robostrich_suite import workspace
-from robostrich_suite.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
+from robostrich_suite import physics as physics_lib
+from robostrich_suite.model import arm as arm_lib
+from robostrich_suite.model import scenes
+from robostrich_suite.studies import workspace
+from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
 
 PATTERNS = ("rolling", "lever")
 SETTLE_TIME = 3.0  # s before the ventral ramps start: the start pose comes to rest
@@ -124,8 +37,8 @@ RECORD_EVERY = int(round(CONTROL_TIMESTEP / PHYSICS_TIMESTEP))  # physics steps 
 class MovementConfig:
     """Scripted inputs of one movement test (contractions in metres).
 
-    The defaults are the setting in which the paper's difference shows (see the
-    module docstring): ventral slips four joints long, the dorsal servo's input
+    The defaults are the setting in which the paper's difference shows (see
+    docs/movement.md): ventral slips four joints long, the dorsal servo's input
     held, rolling as a travelling wave.  ``PAPER_LAYOUT`` is the same test on the
     tasks' arm, whose ventral tendons all run from the base.
     """
@@ -181,7 +94,7 @@ def ventral_amplitudes(config: MovementConfig, physics: mjcf.Physics) -> np.ndar
     """The contraction (m) each ventral tendon is ramped to: the configured amplitude,
     clipped to that tendon's input range (so most get less than asked)."""
     low, high = physics.model.actuator_ctrlrange.T
-    ventral = arm_lib.ventral_indices(physics.model)
+    ventral = physics_lib.ventral_indices(physics.model)
     return np.clip(config.ventral_amplitude(), low[ventral], high[ventral])
 
 
@@ -191,8 +104,8 @@ def schedule(config: MovementConfig, physics: mjcf.Physics):
     Both patterns start from the same pose (dorsal at ``dorsal``, the most caudal
     ventral tendon at ``amplitude``) and ramp the others over the same total time.
     """
-    ventral = arm_lib.ventral_indices(physics.model)
-    dorsal = arm_lib.dorsal_index(physics.model)
+    ventral = physics_lib.ventral_indices(physics.model)
+    dorsal = physics_lib.dorsal_index(physics.model)
     amplitude = ventral_amplitudes(config, physics)
     total = (len(ventral) - 1) * config.ramp_time
 
@@ -221,7 +134,7 @@ class Movement:
     """What one movement test did, one row per recorded frame."""
     config: MovementConfig
     tendon_names: list[str]
-    tendon_sides: list[str]  # arm.tendon_sides: "dorsal" or "ventral" per tendon
+    tendon_sides: list[str]  # physics.tendon_sides: "dorsal" or "ventral" per tendon
     time: np.ndarray  # (n,) s
     control: np.ndarray  # (n, nu) actuator inputs (m)
     contraction: np.ndarray  # (n, nu) measured tendon contractions (m)
@@ -271,7 +184,7 @@ def _chain_points(physics: mjcf.Physics, spec: arm_lib.ArmSpec) -> np.ndarray:
     names = [f"{arm_lib.ARM_MODEL_NAME}/{n}" for n in reversed(spec.joint_names)]
     points = [physics.named.data.xpos[n][[0, 2]] for n in names]
     head = physics.named.data.xpos[names[-1]]
-    axis = arm_lib.head_axis(physics)
+    axis = physics_lib.head_axis(physics)
     points.append((head + spec.head_length * axis)[[0, 2]])
     return np.array(points)
 
@@ -281,18 +194,18 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
         ) -> Movement:
     """Simulate one movement test; log it to ``recording`` (a Rerun stream) if given."""
     spec = spec or arm_lib.ArmSpec.from_table1()
-    physics = physics or workspace.frame_physics(spec, config.layout(spec))
-    ventral = arm_lib.ventral_indices(physics.model)
+    physics = physics or scenes.frame_physics(spec, config.layout(spec))
+    ventral = physics_lib.ventral_indices(physics.model)
     config.validate(len(ventral))
-    dorsal = arm_lib.dorsal_index(physics.model)
+    dorsal = physics_lib.dorsal_index(physics.model)
     model = physics.model
-    indices = arm_lib.arm_indices(model)
+    indices = physics_lib.arm_indices(model)
     tendon_ids, rest = indices.tendons, indices.rest_lengths
     targets = schedule(config, physics)
     dt = model.opt.timestep
     steps = int(round(config.duration(len(ventral)) / dt))
     names = [model.id2name(i, "actuator").split("/")[-1] for i in range(model.nu)]
-    sides = arm_lib.tendon_sides(model)
+    sides = physics_lib.tendon_sides(model)
 
     if recording is not None:
         from robostrich_suite import rerun_log
@@ -415,10 +328,10 @@ def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int
     comes to rest.  Inputs are drawn as ``u**2`` times each tendon's range (more small
     contractions, where the head moves most), a third of them with four tendons slack."""
     spec = spec or arm_lib.ArmSpec.from_table1()
-    physics = workspace.frame_physics(spec, layout)
+    physics = scenes.frame_physics(spec, layout)
     model = physics.model
-    ventral, dorsal_id = arm_lib.ventral_indices(physics.model), arm_lib.dorsal_index(physics.model)
-    indices = arm_lib.arm_indices(model)
+    ventral, dorsal_id = physics_lib.ventral_indices(physics.model), physics_lib.dorsal_index(physics.model)
+    indices = physics_lib.arm_indices(model)
     tendon_ids, rest = indices.tendons, indices.rest_lengths
     high = model.actuator_ctrlrange[ventral, 1]
     rng = np.random.default_rng(seed)

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import hashlib
 import pathlib
 import time
 
@@ -24,45 +23,29 @@ import mujoco
 import numpy as np
 from dm_control import mjcf
 
-from robostrich_suite import arm as arm_lib
 from robostrich_suite import cli as cli_lib
-from robostrich_suite.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
+from robostrich_suite import physics as physics_lib
+from robostrich_suite.model import arm as arm_lib
+from robostrich_suite.model import fingerprint as fingerprint_lib
+from robostrich_suite.model import scenes
+from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
 # Joint limits are soft constraints (arm.ArmSpec.limit_solref): a settled pose may
 # sit slightly past Table 1.  Measured over 1200 random tendon inputs: at most 0.8 deg.
 LIMIT_TOLERANCE_DEG = 1.0
 
 
-def model_fingerprint(spec: arm_lib.ArmSpec | None = None,
-                      layout: arm_lib.TendonLayout | None = None) -> str:
-    """Short hash of what decides where the arm comes to rest; a pose set made with
-    another arm is stale.  Colours, names and sensors do not count."""
-    model = frame_physics(spec, layout).model
-    digest = hashlib.sha256()
-    for field in ("body_pos", "body_quat", "body_mass", "body_inertia", "jnt_range",
-                  "jnt_stiffness", "jnt_solref", "jnt_solimp", "dof_damping", "dof_armature",
-                  "site_pos", "geom_size", "actuator_gainprm", "actuator_biasprm",
-                  "actuator_ctrlrange", "actuator_forcerange", "wrap_objid"):
-        digest.update(np.round(np.asarray(getattr(model, field), np.float64), 9).tobytes())
-    digest.update(np.array([model.opt.timestep, model.opt.integrator], np.float64).tobytes())
-    return digest.hexdigest()[:16]
-
-
-def frame_physics(spec=None, layout=None) -> mjcf.Physics:
-    return mjcf.Physics.from_mjcf_model(arm_lib.build_frame_arm(spec, layout))
-
-
 def head_position_xz(physics: mjcf.Physics) -> np.ndarray:
-    return arm_lib.head_position(physics)[[0, 2]]
+    return physics_lib.head_position(physics)[[0, 2]]
 
 
 def head_attitude_deg(physics: mjcf.Physics) -> float:
     """Angle of the head axis from the vertical in the x-z plane: 90 = level."""
-    return arm_lib.head_attitude_deg(physics)
+    return physics_lib.head_attitude_deg(physics)
 
 
 def arm_joint_angles(physics: mjcf.Physics) -> np.ndarray:
     """The arm's joint angles (rad) in Table 1 order (atlas first)."""
-    return np.array(physics.data.qpos[arm_lib.arm_indices(physics.model).qpos])
+    return np.array(physics.data.qpos[physics_lib.arm_indices(physics.model).qpos])
 
 
 def base_joint_xz(physics: mjcf.Physics, spec: arm_lib.ArmSpec | None = None) -> np.ndarray:
@@ -88,7 +71,7 @@ class KinematicSamples:
 
     def level(self, tolerance_deg: float = LEVEL_TOLERANCE_DEG) -> np.ndarray:
         """Mask of the paper's blue region: head attitude 90 +- tolerance deg."""
-        return np.abs(arm_lib.attitude_error_deg(self.head_attitude, LEVEL_ATTITUDE_DEG)) <= tolerance_deg
+        return np.abs(physics_lib.attitude_error_deg(self.head_attitude, LEVEL_ATTITUDE_DEG)) <= tolerance_deg
 
 
 EDGE_SPREAD = 0.1  # per-joint spread of an edge sample around its segment's limit fraction
@@ -127,11 +110,11 @@ def kinematic_samples(num_samples: int, seed: int = 0, spec: arm_lib.ArmSpec | N
     """``num_samples`` uniform joint angles within Table 1's limits (plus ``num_edge`` edge
     samples, see :func:`sample_joint_angles`); head pose by MuJoCo forward kinematics."""
     spec = spec or arm_lib.ArmSpec.from_table1()
-    physics = physics or frame_physics(spec)
+    physics = physics or scenes.frame_physics(spec)
     angles = sample_joint_angles(num_samples, num_edge, np.random.default_rng(seed), spec)
     total = len(angles)
     model, data = physics.model.ptr, physics.data.ptr
-    indices = arm_lib.arm_indices(physics.model)
+    indices = physics_lib.arm_indices(physics.model)
     qpos_adr, site, head_body = indices.qpos, indices.head_site, indices.head_body
     positions = np.empty((total, 2))
     axes = np.empty((total, 2))
@@ -144,7 +127,7 @@ def kinematic_samples(num_samples: int, seed: int = 0, spec: arm_lib.ArmSpec | N
         mujoco.mj_kinematics(model, data)
         positions[i] = data.site_xpos[site, [0, 2]]
         axes[i] = data.xmat[head_body, [2, 8]]  # head z axis: world x and z components
-    attitudes = arm_lib.continuous_attitude_deg(np.degrees(np.arctan2(axes[:, 0], axes[:, 1])), angles)
+    attitudes = physics_lib.continuous_attitude_deg(np.degrees(np.arctan2(axes[:, 0], axes[:, 1])), angles)
     uniform = np.arange(total) < num_samples
     return KinematicSamples(angles, positions, attitudes, uniform)
 
@@ -162,7 +145,7 @@ class ActuatedSamples:
 
     def level(self, tolerance_deg: float = LEVEL_TOLERANCE_DEG) -> np.ndarray:
         """Mask of settled poses with the head level (90 +- tolerance deg)."""
-        return self.settled & (np.abs(arm_lib.attitude_error_deg(self.head_attitude, LEVEL_ATTITUDE_DEG))
+        return self.settled & (np.abs(physics_lib.attitude_error_deg(self.head_attitude, LEVEL_ATTITUDE_DEG))
                                 <= tolerance_deg)
 
     @classmethod
@@ -187,20 +170,20 @@ LEVEL_SEEK_GAIN = 1e-3  # m of dorsal input per degree of attitude error per sec
 
 
 def seek_level(physics: mjcf.Physics, control: np.ndarray, seek_time: float) -> np.ndarray:
-    """From reset, hold ``control`` but servo the dorsal input (:func:`arm.dorsal_index`) on
+    """From reset, hold ``control`` but servo the dorsal input (:func:`physics_lib.dorsal_index`) on
     the head attitude towards 90 deg for ``seek_time`` seconds; return the inputs with the
     final dorsal input.
 
     The result is only a candidate: :func:`settle` then holds it constant from reset, and
     only a pose that comes to rest level there counts."""
     control = np.array(control, dtype=float)
-    dorsal = arm_lib.dorsal_index(physics.model)
+    dorsal = physics_lib.dorsal_index(physics.model)
     low, high = physics.model.actuator_ctrlrange[dorsal]
     dt = physics.model.opt.timestep
     physics.reset()
     physics.data.ctrl[:] = control
     for _ in range(int(round(seek_time / dt))):
-        error = float(arm_lib.attitude_error_deg(head_attitude_deg(physics), LEVEL_ATTITUDE_DEG))
+        error = float(physics_lib.attitude_error_deg(head_attitude_deg(physics), LEVEL_ATTITUDE_DEG))
         control[dorsal] = np.clip(control[dorsal] + LEVEL_SEEK_GAIN * error * dt, low, high)
         physics.data.ctrl[dorsal] = control[dorsal]
         physics.step()
@@ -218,7 +201,7 @@ def actuated_samples(num_samples: int, seed: int = 0, settle_time: float = 1.5,
     raises the share of level poses from 3.5 % to 42 % for 2.7 times the simulation.
     """
     spec = spec or arm_lib.ArmSpec.from_table1()
-    physics = physics or frame_physics(spec, layout)
+    physics = physics or scenes.frame_physics(spec, layout)
     rng = np.random.default_rng(seed)
     low, high = physics.model.actuator_ctrlrange.T
     controls = rng.uniform(low, high, size=(num_samples, physics.model.nu))
@@ -330,7 +313,7 @@ def save_samples(path: str | pathlib.Path, kinematic: KinematicSamples,
                        for f in dataclasses.fields(actuated) if getattr(actuated, f.name) is not None})
         arrays["actuated_level"] = actuated.level()
     np.savez_compressed(path, base_joint_xz=base_xz, reach_radius=reach_radius(),
-                        fingerprint=np.array(model_fingerprint()), **arrays)
+                        fingerprint=np.array(fingerprint_lib.model_fingerprint()), **arrays)
     return path
 
 
@@ -369,7 +352,7 @@ def main(argv=None) -> dict:
         parser.error("argument --samples: --samples and --edge-samples are both 0: no kinematic workspace to draw")
 
     start = time.perf_counter()
-    physics = frame_physics()
+    physics = scenes.frame_physics()
     kinematic = kinematic_samples(args.samples, args.seed, physics=physics,
                                   progress=not args.no_progress, num_edge=args.edge_samples)
     actuated = None

@@ -28,13 +28,12 @@ naming the offending item.
 from __future__ import annotations
 
 import dataclasses
-from typing import NamedTuple
 
 import numpy as np
 from dm_control import mjcf
 
-from robostrich_suite import table1
-from robostrich_suite.conventions import PHYSICS_TIMESTEP
+from robostrich_suite.model import table1
+from robostrich_suite.tasks.conventions import PHYSICS_TIMESTEP
 
 SIDES = ("dorsal", "ventral")
 ARM_MODEL_NAME = "arm"
@@ -281,7 +280,7 @@ class TendonLayout:
                                  "from caudal to cranial without repeats")
 
 
-def _hole_site_name(link: str, side: str) -> str:
+def hole_site_name(link: str, side: str) -> str:
     return f"{link}_{side}_hole"
 
 
@@ -346,7 +345,7 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
         else:
             body.add("geom", name=f"{name}_geom", fromto=[0, 0, 0, 0, 0, length], mass=masses[name])
         for side in SIDES:
-            body.add("site", name=_hole_site_name(name, side),
+            body.add("site", name=hole_site_name(name, side),
                      pos=[side_x[side], 0, spec.hole_fraction * length])
         parent, pos = body, length
 
@@ -360,7 +359,7 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
                               size=[0.003], rgba=[0.2, 0.7, 0.2, 1])
             element.add("site", site=anchor)
         for link in tendon.links:
-            element.add("site", site=_hole_site_name(link, tendon.side))
+            element.add("site", site=hole_site_name(link, tendon.side))
 
     _add_tendon_servos(model, spec, layout)
     return model
@@ -398,171 +397,7 @@ def _add_tendon_servos(model: mjcf.RootElement, spec: ArmSpec, layout: TendonLay
             gainprm=[-kp], biasprm=[kp * rest_length, -kp, -kv])
 
 
-FRAME_HEIGHT = 0.05  # m, top of the immobile frame, where the arm's base sits
-
-
-def build_frame_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None,
-                    base_height: float = FRAME_HEIGHT) -> mjcf.RootElement:
-    """The arm on an immobile frame (the paper's first setup), neck pointing up.
-
-    The frame's top carries the arm's base; the base link's joint is at
-    ``(0, 0, base_height + anchor_depth)`` in the world.
-    """
-    spec = spec or ArmSpec.from_table1()
-    arena = mjcf.RootElement(model="robostrich")
-    arena.compiler.angle = "radian"
-    arena.option.timestep = PHYSICS_TIMESTEP
-    arena.option.integrator = "implicitfast"
-    arena.visual.headlight.set_attributes(ambient=[0.4, 0.4, 0.4], diffuse=[0.6, 0.6, 0.6])
-    arena.asset.add("texture", name="grid", type="2d", builtin="checker", width=256, height=256,
-                    rgb1=[0.2, 0.3, 0.4], rgb2=[0.25, 0.35, 0.45])
-    arena.asset.add("material", name="grid", texture="grid", texrepeat=[8, 8], reflectance=0.1)
-    arena.worldbody.add("light", pos=[0, -1, 2], dir=[0, 1, -1])
-    arena.worldbody.add("geom", name="floor", type="plane", size=[2, 2, 0.05], material="grid",
-                        pos=[0, 0, -0.4])
-    arena.worldbody.add("geom", name="frame_post", type="box", size=[0.02, 0.04, 0.2],
-                        pos=[-0.02, 0, base_height - 0.2], rgba=[0.4, 0.4, 0.45, 1])
-    arena.worldbody.add("camera", name="side", pos=[0.25, -1.4, 0.35], xyaxes=[1, 0, 0, 0, 0, 1])
-    mount = arena.worldbody.add("site", name="arm_mount",
-                                pos=[0, 0, base_height + spec.anchor_depth], size=[0.005])
-    mount.attach(build_arm(spec, layout))
-    return arena
-
-
 HEAD_SITE_PATH = f"{ARM_MODEL_NAME}/{HEAD_SITE}"
-
-
-_COUNTS = {"body": "nbody", "joint": "njnt", "actuator": "nu", "tendon": "ntendon",
-           "site": "nsite", "geom": "ngeom"}
-
-
-def arm_ids(model, kind: str) -> np.ndarray:
-    """Ids of the attached arm's elements of ``kind`` ("body", "joint", "actuator", ...) in
-    model order: the arm is whatever is named under its ``ARM_MODEL_NAME/`` prefix."""
-    prefix = ARM_MODEL_NAME + "/"
-    return np.array([i for i in range(getattr(model, _COUNTS[kind]))
-                     if (model.id2name(i, kind) or "").startswith(prefix)], dtype=int)
-
-
-class ArmIndices(NamedTuple):
-    """Where the attached arm sits in a compiled model (see :func:`arm_indices`)."""
-    joints: np.ndarray  # hinge joint ids, Table 1 order (atlas first)
-    qpos: np.ndarray  # their qpos addresses
-    dofs: np.ndarray  # their dof addresses
-    actuators: np.ndarray  # tendon actuator ids, in action order
-    tendons: np.ndarray  # each actuator's tendon id
-    head_site: int
-    head_body: int
-    head_velocity: int  # sensordata address of the head's linear velocity
-    servo_gain: np.ndarray  # kp of each tendon servo
-    servo_bias: np.ndarray  # kp * rest length of each tendon servo
-
-    @property
-    def rest_lengths(self) -> np.ndarray:
-        """Length of each tendon in the straight pose (m): the servo's zero contraction."""
-        return self.servo_bias / self.servo_gain  # (kp * rest) / kp, fixed at model creation
-
-
-def arm_indices(model) -> ArmIndices:
-    """Find the attached arm in ``model`` (a dm_control physics' model): the one place that
-    does; callers that read it every step cache the result per model."""
-    joints = np.array([j for j in arm_ids(model, "joint") if model.jnt_type[j] == 3],
-                      dtype=int)  # hinges
-    joints = joints[::-1]  # generator adds caudal first; Table 1 is cranial first
-    actuators = arm_ids(model, "actuator")
-    head_site = int(model.name2id(HEAD_SITE_PATH, "site"))
-    sensor = model.name2id(f"{ARM_MODEL_NAME}/{HEAD_VELOCITY_SENSOR}", "sensor")
-    return ArmIndices(joints, np.array(model.jnt_qposadr[joints]),
-                      np.array(model.jnt_dofadr[joints]), actuators,
-                      np.array(model.actuator_trnid[actuators, 0], dtype=int), head_site,
-                      int(model.site_bodyid[head_site]), int(model.sensor_adr[sensor]),
-                      -model.actuator_gainprm[actuators, 0].copy(),
-                      model.actuator_biasprm[actuators, 0].copy())
-
-
-def tendon_sides(model) -> list[str]:
-    """The side (one of ``SIDES``) of each of the arm's tendons, in action order.
-
-    Read from the model: a tendon runs through the holes of its ``TendonSpec.side``
-    (``build_arm`` names them so), so its last hole says its side whatever its name.
-    ``model`` is a physics' model with an attached arm (other actuators are skipped).
-    """
-    hole_suffixes = {side: _hole_site_name("", side) for side in SIDES}
-    sides = []
-    for i in arm_ids(model, "actuator"):
-        tendon = model.actuator_trnid[i, 0]
-        last_site = model.wrap_objid[model.tendon_adr[tendon] + model.tendon_num[tendon] - 1]
-        name = model.id2name(int(last_site), "site")
-        sides.append(next(side for side, suffix in hole_suffixes.items()
-                          if name.endswith(suffix)))
-    return sides
-
-
-def dorsal_index(model) -> int:
-    """Action index of the arm's dorsal tendon: the first one on the dorsal side (every
-    layout lists the paper's dorsal tendon, the one to the head, first)."""
-    sides = tendon_sides(model)
-    if "dorsal" not in sides:
-        raise ValueError("the arm has no dorsal tendon")
-    return sides.index("dorsal")
-
-
-def ventral_indices(model) -> list[int]:
-    """Action indices of the arm's ventral tendons, in action order."""
-    return [i for i, side in enumerate(tendon_sides(model)) if side == "ventral"]
-
-
-def head_velocity(physics) -> np.ndarray:
-    """World linear velocity (x, y, z) of the head site."""
-    return np.array(physics.named.data.sensordata[f"{ARM_MODEL_NAME}/{HEAD_VELOCITY_SENSOR}"])
-
-
-def head_position(physics) -> np.ndarray:
-    """World position (x, y, z) of the head site of an attached arm."""
-    return np.array(physics.named.data.site_xpos[HEAD_SITE_PATH])
-
-
-def head_axis(physics) -> np.ndarray:
-    """World direction of the head's long axis (the head body's z axis)."""
-    site_id = physics.model.name2id(HEAD_SITE_PATH, "site")
-    body_id = physics.model.site_bodyid[site_id]
-    return np.array(physics.data.xmat[body_id]).reshape(3, 3)[:, 2]
-
-
-def continuous_attitude_deg(axis_angle_deg, joint_angles_rad):
-    """Head attitude (deg) continuous over every pose the arm can take.
-
-    ``axis_angle_deg`` is the head axis' angle from the vertical as ``atan2``
-    gives it, in (-180, 180]; it jumps by 360 deg when the head passes
-    straight down, while Table 1's limits let the joints sum from -409 to
-    +292 deg.  In a planar chain of parallel hinges the attitude is the base's
-    attitude plus the sum of the joint angles; the base (a frame or a
-    quadruped's trunk) never turns by 180 deg, so taking the ``atan2`` value
-    360k away that lies nearest the joint sum gives one continuous attitude.
-    Works on scalars and on arrays ((n,) angles with (n, joints) joints).
-    """
-    summed = np.degrees(np.sum(joint_angles_rad, axis=-1))
-    return axis_angle_deg + 360.0 * np.round((summed - axis_angle_deg) / 360.0)
-
-
-def attitude_error_deg(attitude_deg, desired_deg):
-    """How far the head is turned from ``desired_deg``, in [-180, 180) deg.
-
-    The attitude itself is continuous and can differ from level by more than a
-    turn (a neck curled back by -270 deg holds the head level, facing forward,
-    as at +90); the error is about where the head points, so it is taken
-    modulo a turn.  Its magnitude is continuous everywhere, so are rewards on it.
-    """
-    return (np.asarray(attitude_deg) - desired_deg + 180.0) % 360.0 - 180.0
-
-
-def head_attitude_deg(physics) -> float:
-    """Head attitude in the world's x-z plane: 0 up, 90 level (paper Fig. 2B), 180 down,
-    continuous past 180 (see :func:`continuous_attitude_deg`)."""
-    axis = head_axis(physics)
-    qpos_adr = arm_indices(physics.model).qpos[::-1]  # caudal first, as the sum always was
-    return float(continuous_attitude_deg(float(np.degrees(np.arctan2(axis[0], axis[2]))),
-                                         physics.data.qpos[qpos_adr]))
 
 
 def reach(spec: ArmSpec) -> float:

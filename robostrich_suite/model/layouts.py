@@ -1,7 +1,7 @@
 """Named tendon layouts, and layouts read from a small declarative file (issue 13).
 
 The paper tested one routing and left "the comparison of various tendon
-configurations" open; ``robostrich-layouts`` (:mod:`robostrich_suite.layout_compare`)
+configurations" open; ``robostrich-layouts`` (:mod:`robostrich_suite.studies.layout_compare`)
 compares the ones here.  Every built-in uses the Table 1 links, at most
 :data:`MAX_TENDONS` tendons and the generator's servos (ranges from the joint
 limits, the same force limit), so only the routing differs.
@@ -34,10 +34,10 @@ import json
 import pathlib
 from typing import Callable
 
-from robostrich_suite import arm as arm_lib
+from robostrich_suite.model import arm as arm_lib
 
 MAX_TENDONS = 9  # the paper's 9 servos: the comparison is at the same actuation budget
-DATA_DIR = pathlib.Path(__file__).parent / "data"
+DATA_DIR = pathlib.Path(__file__).resolve().parents[1] / "data"
 
 # Antagonist pairs: the neck cut into four stretches, each with a dorsal and a ventral
 # slip between the same two links, plus the paper's dorsal tendon to the head.  The

@@ -12,7 +12,7 @@ import dataclasses
 
 import numpy as np
 
-from robostrich_suite import workspace
+from robostrich_suite.studies import workspace
 
 CELL_SIZE = 0.02  # m, side of a blue-region cell
 HOLD_DISTANCE = 0.02  # m, how near a held level head must come to a blue sample

@@ -3,14 +3,14 @@
 Every case is one routing on the same Table 1 links.  Per case:
 
 * **coverage**: the share of the kinematic blue-region cells (Fig. 6, head at
-  90 +- 5 deg; :mod:`robostrich_suite.coverage`) in which the actuated arm holds its
+  90 +- 5 deg; :mod:`robostrich_suite.studies.coverage`) in which the actuated arm holds its
   head level, from two samplers run alike for every case: random held inputs with
-  the dorsal input tuned for a level head (``targets.generate``'s way) and one sought
-  pose per blue sample (:mod:`robostrich_suite.pose_seek`);
+  the dorsal input tuned for a level head (``target_generation.generate``'s way) and one sought
+  pose per blue sample (:mod:`robostrich_suite.studies.pose_seek`);
 * **distinct level targets**: the held level poses at least 1 cm apart (the
   tasks' target spacing); they are written as the case's own target file;
 * **rolling / lever**: the movement tests' attitude ranges at equal head travel and
-  their ratio (:mod:`robostrich_suite.movement`; the layout's ventral tendons ramped
+  their ratio (:mod:`robostrich_suite.studies.movement`; the layout's ventral tendons ramped
   caudal to cranial, its most cranial dorsal tendon's input held);
 * **lookup**: held-out success of the no-learning baseline (nearest stored level
   pose, hold its inputs) on the case's own targets; with ``--train``, the held-out
@@ -29,11 +29,13 @@ import time
 
 import numpy as np
 
-from robostrich_suite import arm as arm_lib
 from robostrich_suite import cli as cli_lib
-from robostrich_suite import coverage as coverage_lib
-from robostrich_suite import layouts as layouts_lib
-from robostrich_suite import movement, pose_seek, targets, workspace
+from robostrich_suite import targets
+from robostrich_suite.model import arm as arm_lib
+from robostrich_suite.model import fingerprint as fingerprint_lib
+from robostrich_suite.model import layouts as layouts_lib
+from robostrich_suite.studies import coverage as coverage_lib
+from robostrich_suite.studies import movement, pose_seek, target_generation, workspace
 
 PROG = "robostrich-layouts"
 DEFAULT_KINEMATIC_SAMPLES = 100_000  # the issue's blue region: workspace.kinematic_samples(100000)
@@ -164,7 +166,7 @@ def measure(case: Case, region: coverage_lib.BlueRegion, options: Options, progr
     for start in range(0, options.random_samples, RANDOM_CHUNK):  # chunks: the bar moves
         size = min(RANDOM_CHUNK, options.random_samples - start)
         random.append(workspace.actuated_samples(size, [options.seed, start], pose_seek.HOLD_TIME,
-                                                 seek_level_time=targets.SEEK_LEVEL_TIME,
+                                                 seek_level_time=target_generation.SEEK_LEVEL_TIME,
                                                  spec=case.spec, layout=case.layout))
         progress(size)
     sought = pose_seek.seek_samples(region.head_position, region.joint_angles, case.spec,
@@ -174,10 +176,10 @@ def measure(case: Case, region: coverage_lib.BlueRegion, options: Options, progr
     held = samples.head_position[level]
     covered = region.covered(held)
     target_path = options.out / "targets" / f"{case.label}.npz"
-    targets.save_level_poses(target_path, dict(head_position=held,
+    target_generation.save_level_poses(target_path, dict(head_position=held,
                                                head_attitude=samples.head_attitude[level],
                                                control=samples.control[level]),
-                             workspace.model_fingerprint(case.spec, case.layout))
+                             fingerprint_lib.model_fingerprint(case.spec, case.layout))
     row = {"layout": case.label, "source": case.source,
            "joint_stiffness": case.spec.joint_stiffness, "tendons": len(case.layout),
            "blue_cells": region.num_cells, "covered_cells": int(covered.sum()),
@@ -381,7 +383,7 @@ def main(argv=None) -> dict:
         f"{args.random_samples} random + {len(region.head_position)} sought poses per layout.\n\n"
         + table)
     write_csv(args.out / "layouts.csv", rows)
-    from robostrich_suite import layout_figure
+    from robostrich_suite.studies import layout_figure
     figure = layout_figure.plot(cases, region, results, args.out / "layouts.png")
     print(table, end="")
     best = max(rows, key=lambda row: row["coverage"])

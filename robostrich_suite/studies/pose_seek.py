@@ -19,23 +19,25 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from robostrich_suite import arm as arm_lib
-from robostrich_suite import conventions
-from robostrich_suite import movement, workspace
-from robostrich_suite.robostrich import DEFAULT_TIME_LIMIT
+from robostrich_suite import physics as physics_lib
+from robostrich_suite.model import arm as arm_lib
+from robostrich_suite.model import scenes
+from robostrich_suite.studies import workspace
+from robostrich_suite.tasks import conventions
+from robostrich_suite.tasks.lessons import LESSON_TIME_LIMIT
 
 SEEK_TIME = 8.0  # s of input adjustment per target
 SEEK_GAIN = 0.003  # fraction of the wanted tendon-length change applied per update
 UPDATE_EVERY = 4  # physics steps per update: the environments' control step
 ATTITUDE_SCALE = 0.1  # m per rad: how a degree of attitude error weighs against position
 DAMPING = 1e-4  # of the least-squares joint step
-HOLD_TIME = DEFAULT_TIME_LIMIT  # s a candidate is held from the fixed start: one episode
+HOLD_TIME = LESSON_TIME_LIMIT  # s a candidate is held from the fixed start: one episode
 
 
 def contraction_at(physics, joint_angles: np.ndarray, spec: arm_lib.ArmSpec) -> np.ndarray:
     """Every tendon's contraction (servo rest length minus length) in the pose ``joint_angles``."""
     model = physics.model
-    indices = arm_lib.arm_indices(model)
+    indices = physics_lib.arm_indices(model)
     qpos_adr = indices.qpos
     with physics.reset_context():
         physics.data.qpos[qpos_adr] = joint_angles
@@ -62,11 +64,11 @@ def seek_pose(physics, target_xz, control, seek_time: float = SEEK_TIME,
         if step % UPDATE_EVERY == 0:
             mujoco.mj_jacSite(model, data, jacp, jacr, site)
             head_axis = data.xmat[head_body, [2, 8]]
-            attitude = arm_lib.continuous_attitude_deg(
+            attitude = physics_lib.continuous_attitude_deg(
                 np.degrees(np.arctan2(*head_axis)), data.qpos[:model.nv])
             error = np.array([target_xz[0] - data.site_xpos[site, 0],
                               target_xz[1] - data.site_xpos[site, 2],
-                              ATTITUDE_SCALE * np.radians(float(arm_lib.attitude_error_deg(
+                              ATTITUDE_SCALE * np.radians(float(physics_lib.attitude_error_deg(
                                   conventions.LEVEL_ATTITUDE_DEG, attitude)))])
             jacobian = np.stack([jacp[0], jacp[2], ATTITUDE_SCALE * jacr[1]])
             joint_step = jacobian.T @ np.linalg.solve(jacobian @ jacobian.T + DAMPING * np.eye(3), error)
@@ -85,7 +87,7 @@ def seek_samples(targets_xz, joint_angles, spec: arm_lib.ArmSpec | None = None,
     ``joint_angles[i]`` to start from), held from the fixed start: the same record as
     :func:`workspace.actuated_samples`.  ``progress(n)`` is called after each."""
     spec = spec or arm_lib.ArmSpec.from_table1()
-    physics = workspace.frame_physics(spec, layout)
+    physics = scenes.frame_physics(spec, layout)
     count = len(targets_xz)
     result = workspace.ActuatedSamples(np.zeros((count, 2)), np.zeros(count),
                                        np.zeros((count, physics.model.nu)), np.zeros(count, bool),

@@ -15,7 +15,7 @@ import dataclasses
 
 import numpy as np
 
-from robostrich_suite import arm as arm_lib
+from robostrich_suite import physics as physics_lib
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,10 +46,10 @@ class Randomizer:
 
     def _remember(self, physics):
         model = physics.model
-        bodies = arm_lib.arm_ids(model, "body")
-        joints = arm_lib.arm_ids(model, "joint")
+        bodies = physics_lib.arm_ids(model, "body")
+        joints = physics_lib.arm_ids(model, "joint")
         dofs = model.jnt_dofadr[joints]
-        actuators = arm_lib.arm_ids(model, "actuator")
+        actuators = physics_lib.arm_ids(model, "actuator")
         self._nominal = dict(
             bodies=bodies, joints=joints, dofs=dofs, actuators=actuators,
             mass=model.body_mass[bodies].copy(), inertia=model.body_inertia[bodies].copy(),

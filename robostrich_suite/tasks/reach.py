@@ -24,12 +24,13 @@ import numpy as np
 from dm_control.suite import base
 from dm_env import specs
 
-from robostrich_suite import arm as arm_lib
-from robostrich_suite import randomization as randomization_lib
-from robostrich_suite import rewards
-from robostrich_suite.conventions import LEVEL_ATTITUDE_DEG as DESIRED_ATTITUDE
-from robostrich_suite.conventions import LEVEL_TOLERANCE_DEG as ATTITUDE_TOLERANCE
-from robostrich_suite.conventions import POSITION_TOLERANCE
+from robostrich_suite import physics as physics_lib
+from robostrich_suite.tasks import randomization as randomization_lib
+from robostrich_suite.tasks import rewards
+from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG as DESIRED_ATTITUDE
+from robostrich_suite.tasks.conventions import LEVEL_TOLERANCE_DEG as ATTITUDE_TOLERANCE
+from robostrich_suite.tasks.conventions import POSITION_TOLERANCE
+
 INITIAL_STATES = ("fixed", "continue")
 REWARDS = ("lesson1", "lesson2")
 
@@ -184,7 +185,7 @@ class Reach(base.Task):
 
     def attitude_error(self, physics) -> float:
         """Signed head attitude error in degrees (positive = head pitched down), in [-180, 180)."""
-        return float(arm_lib.attitude_error_deg(physics.head_attitude(), self.desired_attitude))
+        return float(physics_lib.attitude_error_deg(physics.head_attitude(), self.desired_attitude))
 
     def is_success(self, physics) -> bool:
         return (self.position_error(physics) <= self.position_tolerance
@@ -227,7 +228,7 @@ class Reach(base.Task):
         obs["target_position"] = self.target_position.copy()
         obs["to_target"] = self.target_position - head
         attitude = physics.head_attitude()  # once: it is the costliest measurement of a step
-        attitude_error = float(arm_lib.attitude_error_deg(attitude, self.desired_attitude))
+        attitude_error = float(physics_lib.attitude_error_deg(attitude, self.desired_attitude))
         obs["attitude_error"] = np.array([np.radians(attitude_error)])
         obs["head_attitude"] = np.array([np.radians(attitude)])
         obs["tendon_contraction"] = physics.tendon_contractions()

@@ -21,16 +21,16 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import robostrich_suite  # noqa: E402
-from robostrich_suite import arm as arm_lib  # noqa: E402
-from robostrich_suite import gait as gait_lib  # noqa: E402
+from robostrich_suite import physics as physics_lib  # noqa: E402
 from robostrich_suite import rerun_log  # noqa: E402
 from robostrich_suite.robostrich_a1 import CONTROL_TIMESTEP, SUITE  # noqa: E402
+from robostrich_suite.tasks import gait as gait_lib  # noqa: E402
 
 
 def scripted_tendons(kind: str, control_range: np.ndarray, dorsal: int):
     """Tendon input as a function of time: ``zero``, or ``sine`` (a slow nod: the ventral
     tendons contract together at 0.5 Hz up to 30 % of their range, the dorsal one, action
-    index ``dorsal`` (:func:`arm.dorsal_index`), pays out)."""
+    index ``dorsal`` (:func:`physics.dorsal_index`), pays out)."""
     low, high = control_range.T
     if kind == "zero":
         return lambda t: np.zeros(len(low))
@@ -61,7 +61,7 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
     env.reset()
     physics = env.physics
     script = scripted_tendons(tendons, physics.arm_control_range(),
-                              arm_lib.dorsal_index(physics.model))
+                              physics_lib.dorsal_index(physics.model))
     rec = None
     if rrd_path is not None:
         rec = rerun_log.recording("robostrich_a1_walk", pathlib.Path(rrd_path))
@@ -185,7 +185,7 @@ def main(argv=None) -> None:
     parser.add_argument("--tendons", default="zero", choices=["zero", "sine"],
                         help="scripted tendon input (zero: the passive neck)")
     parser.add_argument("--gait", default=None,
-                        help="gait file (CSV, see robostrich_suite.gait) or 'trot' for the "
+                        help="gait file (CSV, see robostrich_suite.tasks.gait) or 'trot' for the "
                              "generator; default: the shipped file")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/walk"),
                         help="output directory: writes OUT/walk.rrd and OUT/walk.png "

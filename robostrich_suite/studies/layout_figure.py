@@ -6,10 +6,11 @@ import pathlib
 
 import numpy as np
 
-from robostrich_suite import arm as arm_lib
-from robostrich_suite import conventions
-from robostrich_suite import coverage as coverage_lib
-from robostrich_suite import workspace
+from robostrich_suite.model import arm as arm_lib
+from robostrich_suite.model import scenes
+from robostrich_suite.studies import coverage as coverage_lib
+from robostrich_suite.studies import workspace
+from robostrich_suite.tasks import conventions
 
 SIDE_COLOURS = {"dorsal": ("#b2182b", "#ef8a62", "#67001f"), "ventral": ("#2166ac", "#67a9cf", "#053061")}
 
@@ -88,7 +89,7 @@ def plot(cases, region: coverage_lib.BlueRegion, results, path) -> pathlib.Path:
     columns = len(cases)
     fig, axes = plt.subplots(2, columns, figsize=(max(3.3 * columns, 10.0), 7.2), squeeze=False,
                              gridspec_kw=dict(height_ratios=[2.2, 1.3]))
-    base_xz = workspace.base_joint_xz(workspace.frame_physics(cases[0].spec, cases[0].layout),
+    base_xz = workspace.base_joint_xz(scenes.frame_physics(cases[0].spec, cases[0].layout),
                                       cases[0].spec)
     everything = np.concatenate([region.head_position] + [r["held"] for r in results]
                                 + [base_xz[None]])

@@ -28,7 +28,8 @@ sequence loops with period ``time[-1] - time[0]``, so the last row should
 repeat the first (the shipped file ``data/a1_trot.csv`` does).  A malformed
 file raises ``ValueError`` naming the line and column.
 
-Regenerate the shipped file with ``python -m robostrich_suite.gait``.
+Regenerate the shipped file with
+``python -m robostrich_suite.tasks.gait --out robostrich_suite/data/a1_trot.csv``.
 """
 from __future__ import annotations
 
@@ -43,9 +44,13 @@ import pathlib
 
 import numpy as np
 
-from robostrich_suite import quadruped as quad
+from robostrich_suite.model import quadruped as quad
 
-DATA_PATH = pathlib.Path(__file__).parent / "data" / "a1_trot.csv"
+DATA_PATH = pathlib.Path(__file__).resolve().parents[1] / "data" / "a1_trot.csv"
+# The leg servos (kp 100) sag under the robot's weight: measured trunk height minus
+# command, at 0.22-0.28 m, is -0.010 m standing and -0.019 m on average while trotting.
+# The tasks command the legs that much higher so the trunk's height matches the command.
+SAG_COMPENSATION = {"stand": 0.010, "walk": 0.019}  # m
 COLUMNS = ("time",) + quad.JOINT_NAMES
 L1, L2 = quad.THIGH_LENGTH, quad.CALF_LENGTH
 # Trunk heights the legs can hold while trotting (knee limits with the stride's reach).
@@ -376,7 +381,8 @@ def sample_trot(gait: TrotGait | None = None, cycles: int = 1, rate: float = 100
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description="Write a trot as a gait file (CSV).")
-    parser.add_argument("--out", type=pathlib.Path, default=DATA_PATH)
+    parser.add_argument("--out", type=pathlib.Path, required=True,
+                        help="gait file to write (the shipped one: robostrich_suite/data/a1_trot.csv)")
     parser.add_argument("--frequency", type=float, default=TrotGait.frequency)
     parser.add_argument("--stride", type=float, default=TrotGait.stride)
     parser.add_argument("--lift", type=float, default=TrotGait.lift)
@@ -386,7 +392,7 @@ def main(argv=None) -> None:
     gait = TrotGait(args.frequency, args.stride, args.lift, args.trunk_height)
     times, targets = sample_trot(gait, rate=args.rate)
     write_gait_file(args.out, times, targets, comment=(
-        f"A1-like trot from robostrich_suite.gait.TrotGait: frequency {gait.frequency} Hz, "
+        f"A1-like trot from robostrich_suite.tasks.gait.TrotGait: frequency {gait.frequency} Hz, "
         f"stride {gait.stride} m, lift {gait.lift} m, trunk height {gait.trunk_height} m.\n"
         "Columns: time (s), then 12 joint targets (rad). Loops with period time[-1] - time[0]."))
     print(f"wrote {len(times)} samples to {args.out}")

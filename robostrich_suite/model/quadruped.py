@@ -1,12 +1,11 @@
 """MJCF generator for an A1-like quadruped (public Unitree A1 facts, no downloaded model).
 
-Every number about the robot is a named constant in this module (from
-``../shared/design.md``).  The model is built *without* a free joint so that
-the arm can be attached to its trunk first: ``dm_control.mjcf`` refuses to
-attach a child whose top body has a free joint.  The composition
-(:mod:`robostrich_suite.robostrich_a1`) attaches the arm to ``MOUNT_SITE``,
-puts the quadruped in an arena through an attachment frame and only then adds
-the free joint to that frame.
+Every number about the robot is a named constant in this module.  The model
+is built *without* a free joint so that the arm can be attached to its trunk
+first: ``dm_control.mjcf`` refuses to attach a child whose top body has a free
+joint.  The composition (:func:`robostrich_suite.model.scenes.build_a1`)
+attaches the arm to ``MOUNT_SITE``, then adds the free joint to the trunk and
+the arena (floor, light, obstacles) into this root model.
 
 Conventions (those of the A1): the trunk faces +x, +y is the robot's left.
 Legs are ``FR, FL, RR, RL``; each has an abduction joint (``{leg}_hip``, about
@@ -22,7 +21,7 @@ from dm_control import mjcf
 
 MODEL_NAME = "a1"
 
-# --- Unitree A1 facts (design.md) -------------------------------------------
+# --- Unitree A1 facts (public specifications) -------------------------------------------
 TRUNK_SIZE = (0.25, 0.08, 0.114)  # m, full box sizes (length, width, height)
 TRUNK_MASS = 4.713  # kg
 HIP_OFFSET = (0.183, 0.047, 0.0)  # m, |x|, |y|, z of the hips from the trunk centre

@@ -1,0 +1,26 @@
+"""The model fingerprint: a short hash of what decides where the arm on its frame comes
+to rest.  Target files carry the fingerprint of the arm they were made with, so a pose
+set made with another arm is recognised as stale."""
+from __future__ import annotations
+
+import hashlib
+
+import numpy as np
+
+from robostrich_suite.model import arm as arm_lib
+from robostrich_suite.model import scenes
+
+
+def model_fingerprint(spec: arm_lib.ArmSpec | None = None,
+                      layout: arm_lib.TendonLayout | None = None) -> str:
+    """Short hash of what decides where the arm comes to rest; a pose set made with
+    another arm is stale.  Colours, names and sensors do not count."""
+    model = scenes.frame_physics(spec, layout).model
+    digest = hashlib.sha256()
+    for field in ("body_pos", "body_quat", "body_mass", "body_inertia", "jnt_range",
+                  "jnt_stiffness", "jnt_solref", "jnt_solimp", "dof_damping", "dof_armature",
+                  "site_pos", "geom_size", "actuator_gainprm", "actuator_biasprm",
+                  "actuator_ctrlrange", "actuator_forcerange", "wrap_objid"):
+        digest.update(np.round(np.asarray(getattr(model, field), np.float64), 9).tobytes())
+    digest.update(np.array([model.opt.timestep, model.opt.integrator], np.float64).tobytes())
+    return digest.hexdigest()[:16]

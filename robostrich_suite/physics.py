@@ -1,0 +1,377 @@
+"""The one accessor layer: reading the arm and the quadruped in a compiled model.
+
+Finding the arm in a model (:func:`arm_indices`), which tendon is on which side
+(:func:`tendon_sides`) and the head's attitude are stated here once; tasks and
+studies alike read them from here.  :class:`ArmPhysicsMixin` is mixed into each
+domain's ``Physics`` so tasks read the head, joints and tendons by meaning rather
+than by index; :class:`QuadrupedPhysicsMixin` adds the quadruped's trunk, legs and
+the trunk frame.  Joint angles come in Table 1 order (atlas first, C18 last);
+tendons in actuator (= action) order.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from typing import NamedTuple
+
+import mujoco as mujoco_lib
+import numpy as np
+from dm_control.rl import control
+
+from robostrich_suite.model import arm as arm_lib
+from robostrich_suite.model import quadruped as quad
+from robostrich_suite.tasks import gait as gait_lib
+
+_log = logging.getLogger(__name__)
+
+
+_COUNTS = {"body": "nbody", "joint": "njnt", "actuator": "nu", "tendon": "ntendon",
+           "site": "nsite", "geom": "ngeom"}
+
+
+def arm_ids(model, kind: str) -> np.ndarray:
+    """Ids of the attached arm's elements of ``kind`` ("body", "joint", "actuator", ...) in
+    model order: the arm is whatever is named under its ``arm.ARM_MODEL_NAME/`` prefix."""
+    prefix = arm_lib.ARM_MODEL_NAME + "/"
+    return np.array([i for i in range(getattr(model, _COUNTS[kind]))
+                     if (model.id2name(i, kind) or "").startswith(prefix)], dtype=int)
+
+
+class ArmIndices(NamedTuple):
+    """Where the attached arm sits in a compiled model (see :func:`arm_indices`)."""
+    joints: np.ndarray  # hinge joint ids, Table 1 order (atlas first)
+    qpos: np.ndarray  # their qpos addresses
+    dofs: np.ndarray  # their dof addresses
+    actuators: np.ndarray  # tendon actuator ids, in action order
+    tendons: np.ndarray  # each actuator's tendon id
+    head_site: int
+    head_body: int
+    head_velocity: int  # sensordata address of the head's linear velocity
+    servo_gain: np.ndarray  # kp of each tendon servo
+    servo_bias: np.ndarray  # kp * rest length of each tendon servo
+
+    @property
+    def rest_lengths(self) -> np.ndarray:
+        """Length of each tendon in the straight pose (m): the servo's zero contraction."""
+        return self.servo_bias / self.servo_gain  # (kp * rest) / kp, fixed at model creation
+
+
+def arm_indices(model) -> ArmIndices:
+    """Find the attached arm in ``model`` (a dm_control physics' model): the one place that
+    does; callers that read it every step cache the result per model."""
+    joints = np.array([j for j in arm_ids(model, "joint") if model.jnt_type[j] == 3],
+                      dtype=int)  # hinges
+    joints = joints[::-1]  # generator adds caudal first; Table 1 is cranial first
+    actuators = arm_ids(model, "actuator")
+    head_site = int(model.name2id(arm_lib.HEAD_SITE_PATH, "site"))
+    sensor = model.name2id(f"{arm_lib.ARM_MODEL_NAME}/{arm_lib.HEAD_VELOCITY_SENSOR}", "sensor")
+    return ArmIndices(joints, np.array(model.jnt_qposadr[joints]),
+                      np.array(model.jnt_dofadr[joints]), actuators,
+                      np.array(model.actuator_trnid[actuators, 0], dtype=int), head_site,
+                      int(model.site_bodyid[head_site]), int(model.sensor_adr[sensor]),
+                      -model.actuator_gainprm[actuators, 0].copy(),
+                      model.actuator_biasprm[actuators, 0].copy())
+
+
+def tendon_sides(model) -> list[str]:
+    """The side (one of ``arm.SIDES``) of each of the arm's tendons, in action order.
+
+    Read from the model: a tendon runs through the holes of its ``TendonSpec.side``
+    (``build_arm`` names them so), so its last hole says its side whatever its name.
+    ``model`` is a physics' model with an attached arm (other actuators are skipped).
+    """
+    hole_suffixes = {side: arm_lib.hole_site_name("", side) for side in arm_lib.SIDES}
+    sides = []
+    for i in arm_ids(model, "actuator"):
+        tendon = model.actuator_trnid[i, 0]
+        last_site = model.wrap_objid[model.tendon_adr[tendon] + model.tendon_num[tendon] - 1]
+        name = model.id2name(int(last_site), "site")
+        sides.append(next(side for side, suffix in hole_suffixes.items()
+                          if name.endswith(suffix)))
+    return sides
+
+
+def dorsal_index(model) -> int:
+    """Action index of the arm's dorsal tendon: the first one on the dorsal side (every
+    layout lists the paper's dorsal tendon, the one to the head, first)."""
+    sides = tendon_sides(model)
+    if "dorsal" not in sides:
+        raise ValueError("the arm has no dorsal tendon")
+    return sides.index("dorsal")
+
+
+def ventral_indices(model) -> list[int]:
+    """Action indices of the arm's ventral tendons, in action order."""
+    return [i for i, side in enumerate(tendon_sides(model)) if side == "ventral"]
+
+
+def head_position(physics) -> np.ndarray:
+    """World position (x, y, z) of the head site of an attached arm."""
+    return np.array(physics.named.data.site_xpos[arm_lib.HEAD_SITE_PATH])
+
+
+def head_axis(physics) -> np.ndarray:
+    """World direction of the head's long axis (the head body's z axis)."""
+    site_id = physics.model.name2id(arm_lib.HEAD_SITE_PATH, "site")
+    body_id = physics.model.site_bodyid[site_id]
+    return np.array(physics.data.xmat[body_id]).reshape(3, 3)[:, 2]
+
+
+def continuous_attitude_deg(axis_angle_deg, joint_angles_rad):
+    """Head attitude (deg) continuous over every pose the arm can take.
+
+    ``axis_angle_deg`` is the head axis' angle from the vertical as ``atan2``
+    gives it, in (-180, 180]; it jumps by 360 deg when the head passes
+    straight down, while Table 1's limits let the joints sum from -409 to
+    +292 deg.  In a planar chain of parallel hinges the attitude is the base's
+    attitude plus the sum of the joint angles; the base (a frame or a
+    quadruped's trunk) never turns by 180 deg, so taking the ``atan2`` value
+    360k away that lies nearest the joint sum gives one continuous attitude.
+    Works on scalars and on arrays ((n,) angles with (n, joints) joints).
+    """
+    summed = np.degrees(np.sum(joint_angles_rad, axis=-1))
+    return axis_angle_deg + 360.0 * np.round((summed - axis_angle_deg) / 360.0)
+
+
+def attitude_error_deg(attitude_deg, desired_deg):
+    """How far the head is turned from ``desired_deg``, in [-180, 180) deg.
+
+    The attitude itself is continuous and can differ from level by more than a
+    turn (a neck curled back by -270 deg holds the head level, facing forward,
+    as at +90); the error is about where the head points, so it is taken
+    modulo a turn.  Its magnitude is continuous everywhere, so are rewards on it.
+    """
+    return (np.asarray(attitude_deg) - desired_deg + 180.0) % 360.0 - 180.0
+
+
+def head_attitude_deg(physics) -> float:
+    """Head attitude in the world's x-z plane: 0 up, 90 level (paper Fig. 2B), 180 down,
+    continuous past 180 (see :func:`continuous_attitude_deg`)."""
+    axis = head_axis(physics)
+    qpos_adr = arm_indices(physics.model).qpos[::-1]  # caudal first, as the sum always was
+    return float(continuous_attitude_deg(float(np.degrees(np.arctan2(axis[0], axis[2]))),
+                                         physics.data.qpos[qpos_adr]))
+
+
+class _MujocoWarningCapture(logging.Filter):
+    """Holds back MuJoCo's own warning lines (dm_control sends them to the ``absl``
+    logger) while an arm steps, so that a divergence is reported in one line that
+    quotes them, instead of one line per MuJoCo warning plus ours."""
+
+    def __init__(self):
+        super().__init__()
+        self.active = False
+        self.messages: list[str] = []
+
+    def filter(self, record):
+        if not self.active:
+            return True
+        self.messages.append(record.getMessage())
+        return False
+
+
+_MUJOCO_WARNINGS = _MujocoWarningCapture()
+logging.getLogger("absl").addFilter(_MUJOCO_WARNINGS)
+
+
+class ArmPhysicsMixin:
+    """Accessors for the arm's head, joints and tendons, plus divergence capture."""
+
+    divergence: str | None = None
+    # Episodes started and episodes that diverged, for the one log line per divergence.
+    episodes_started: int = 0
+    episodes_diverged: int = 0
+
+    # Indices are looked up once per model; the model never changes under a Physics.
+    def _arm_indices(self) -> ArmIndices:
+        cache = self.__dict__.get("_arm_index_cache")
+        if cache is None or cache[0] is not self.model.ptr:
+            cache = (self.model.ptr, arm_indices(self.model))
+            self.__dict__["_arm_index_cache"] = cache
+        return cache[1]
+
+    def arm_joint_names(self) -> list[str]:
+        return [self.model.id2name(int(j), "joint") for j in self._arm_indices().joints]
+
+    def tendon_names(self) -> list[str]:
+        return [self.model.id2name(int(i), "actuator") for i in self._arm_indices().actuators]
+
+    def head_position(self) -> np.ndarray:
+        """Head site position (x, y, z) in metres, world frame."""
+        return self.data.site_xpos[self._arm_indices().head_site].copy()
+
+    def head_velocity(self) -> np.ndarray:
+        """Head site linear velocity (x, y, z) in m/s, world frame."""
+        adr = self._arm_indices().head_velocity
+        return self.data.sensordata[adr:adr + 3].copy()
+
+    def head_attitude(self) -> float:
+        """Head attitude in degrees: 90 = head parallel to the ground (paper Fig. 2B); continuous
+        past 180 (no wrap), see :func:`continuous_attitude_deg`."""
+        xmat = self.data.xmat[self._arm_indices().head_body]  # row-major 3x3; column 2 = head axis
+        return float(continuous_attitude_deg(np.degrees(np.arctan2(xmat[2], xmat[8])),
+                                                     self.data.qpos[self._arm_indices().qpos]))
+
+    def joint_angles(self) -> np.ndarray:
+        """The 18 joint angles (rad), atlas first; positive = ventral flexion."""
+        return self.data.qpos[self._arm_indices().qpos].copy()
+
+    def tendon_lengths(self) -> np.ndarray:
+        """Current length of each actuated tendon (m), in action order."""
+        return self.data.ten_length[self._arm_indices().tendons].copy()
+
+    def tendon_rest_lengths(self) -> np.ndarray:
+        """Length of each tendon in the straight pose (m): the servo's zero contraction."""
+        return self._arm_indices().rest_lengths
+
+    def tendon_contractions(self) -> np.ndarray:
+        """How much each tendon is shorter than at rest (m)."""
+        return self.tendon_rest_lengths() - self.tendon_lengths()
+
+    def tendon_forces(self) -> np.ndarray:
+        """Pull in each tendon (N, >= 0), in action order."""
+        return -self.data.actuator_force[self._arm_indices().actuators].copy()
+
+    def tendon_max_forces(self) -> np.ndarray:
+        """Largest pull of each tendon's actuator (N, > 0), in action order."""
+        return -self.model.actuator_forcerange[self._arm_indices().actuators, 0]
+
+    def arm_control(self) -> np.ndarray:
+        return self.data.ctrl[self._arm_indices().actuators].copy()
+
+    def arm_control_range(self) -> np.ndarray:
+        """(9, 2) low/high tendon contractions (m): the action spec's bounds."""
+        return self.model.actuator_ctrlrange[self._arm_indices().actuators]
+
+    def set_arm_control(self, action) -> None:
+        """Write tendon contractions to the arm's actuators only (a robot may have others)."""
+        self.data.ctrl[self._arm_indices().actuators] = action
+
+    def step(self, nstep: int = 1) -> None:
+        """Step, but turn a divergence into a flag the task ends the episode on.
+
+        A divergence ends the episode, so it is logged once per episode: one line
+        with MuJoCo's own warnings and how many episodes have diverged so far."""
+        if self.divergence is not None:
+            return
+        _MUJOCO_WARNINGS.active, _MUJOCO_WARNINGS.messages = True, []
+        try:
+            super().step(nstep)
+        except control.PhysicsError as error:
+            self.divergence = str(error)
+        else:
+            if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
+                self.divergence = "non-finite joint state"
+        finally:
+            _MUJOCO_WARNINGS.active = False
+        if self.divergence is not None:
+            self._log_divergence(_MUJOCO_WARNINGS.messages)
+
+    def _log_divergence(self, mujoco_messages: list[str]) -> None:
+        self.episodes_diverged += 1
+        episodes = max(self.episodes_started, 1)
+        detail = " ".join(mujoco_messages) or self.divergence
+        _log.warning("physics diverged in episode %d, ending it (%d of %d episodes diverged "
+                     "so far): %s", episodes, self.episodes_diverged, episodes, detail)
+
+    def __setstate__(self, state):
+        super().__setstate__(state)
+        # dm_control's Euler step ends each step with mj_step1 and begins the next with
+        # mj_step2, which reuses what mj_step1 computed (constraint rows among it). A
+        # pickled MjData keeps the state but not those, so recompute them: an unpickled
+        # environment (a resumed training run) then continues bit-exactly.
+        mujoco_lib.mj_step1(self.model.ptr, self.data.ptr)
+
+    def reset(self, keyframe_id=None):
+        self.divergence = None
+        self.episodes_started += 1
+        return super().reset(keyframe_id)
+
+
+class QuadrupedPhysicsMixin(ArmPhysicsMixin):
+    """The arm's accessors (``ArmPhysicsMixin``) plus the quadruped's and the trunk frame:
+    origin on the ground under the trunk centre, x along the trunk's heading (projected on
+    the ground), y to its left, z up (see :mod:`robostrich_suite.tasks.quadruped_tasks`)."""
+
+    def _robot(self):
+        cache = self.__dict__.get("_robot_cache")
+        if cache is None or cache["data"] is not self._data:  # a reload makes new data
+            model = self.model
+            legs = list(quad.JOINT_NAMES)
+            cache = dict(
+                data=self._data,
+                trunk=model.name2id(quad.TRUNK_BODY, "body"),
+                leg_actuators=np.array([model.name2id(n, "actuator") for n in legs]),
+                leg_qpos=np.array([model.jnt_qposadr[model.name2id(n, "joint")] for n in legs]),
+                # The arm's first (caudal) joint: the generator adds the chain caudal first.
+                arm_base=int(model.jnt_bodyid[arm_ids(model, "joint")[0]]))
+            self.__dict__["_robot_cache"] = cache
+        return cache
+
+    # Arm head.
+    def head_attitude(self) -> float:
+        """Head attitude (deg) in the trunk's heading plane: 0 up, 90 level, 180 down."""
+        xmat = self.data.xmat[self._arm_indices().head_body]  # head body; row-major: axis z = (2, 5, 8)
+        hx, hy = self.heading()
+        return float(continuous_attitude_deg(
+            math.degrees(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8])),
+            self.data.qpos[self._arm_indices().qpos]))
+
+    # Quadruped.
+    def trunk_position(self) -> np.ndarray:
+        """Trunk centre (x, y, z), world frame."""
+        return self.data.xpos[self._robot()["trunk"]].copy()
+
+    def trunk_velocity(self) -> np.ndarray:
+        """Trunk linear velocity, world frame (the free joint's linear velocity)."""
+        return self.data.qvel[:3].copy()
+
+    def trunk_height(self) -> float:
+        return float(self.data.xpos[self._robot()["trunk"], 2])
+
+    def trunk_uprightness(self) -> float:
+        """z component of the trunk's up axis: 1 upright, 0 on its side."""
+        return float(self.data.xmat[self._robot()["trunk"]][8])
+
+    def heading(self) -> np.ndarray:
+        """Unit (x, y) of the trunk's forward axis projected on the ground."""
+        xmat = self.data.xmat[self._robot()["trunk"]]
+        fx, fy = float(xmat[0]), float(xmat[3])
+        norm = math.hypot(fx, fy)
+        return (fx / norm, fy / norm) if norm > 1e-9 else (1.0, 0.0)
+
+    def to_trunk_frame(self, point, velocity: bool = False) -> np.ndarray:
+        """World point (or velocity) -> (forward, left, up) in the trunk frame (class doc)."""
+        hx, hy = self.heading()
+        x, y, z = (float(c) for c in point)
+        if not velocity:
+            trunk = self.data.xpos[self._robot()["trunk"]]
+            x, y = x - trunk[0], y - trunk[1]
+        return np.array([hx * x + hy * y, -hy * x + hx * y, z])
+
+    def from_trunk_frame(self, forward: float, up: float) -> np.ndarray:
+        """(forward, up) in the trunk frame -> world point in the trunk's vertical plane."""
+        hx, hy = self.heading()
+        x, y, _ = self.trunk_position()
+        return np.array([x + forward * hx, y + forward * hy, up])
+
+    def arm_base_position(self) -> np.ndarray:
+        """World position of the arm's first joint (C18) on the trunk."""
+        return self.data.xpos[self._robot()["arm_base"]].copy()
+
+    def set_leg_targets(self, targets) -> None:
+        self.data.ctrl[self._robot()["leg_actuators"]] = targets
+
+    def place_standing(self, trunk_xy=(0.0, 0.0), trunk_height=quad.STANDING_TRUNK_HEIGHT):
+        """Put the quadruped in its standing pose, feet on the ground, arm straight, at rest."""
+        targets = gait_lib.Standing().joint_targets(0.0, trunk_height + gait_lib.SAG_COMPENSATION["stand"])
+        _, foot_z = gait_lib.leg_fk(targets[1], targets[2])
+        self.data.qpos[:] = 0.0
+        self.data.qpos[:3] = [trunk_xy[0], trunk_xy[1], -foot_z + quad.FOOT_RADIUS]
+        self.data.qpos[3:7] = [1, 0, 0, 0]
+        self.data.qpos[self._robot()["leg_qpos"]] = targets
+        self.data.qvel[:] = 0.0
+        if self.data.act.size:
+            self.data.act[:] = 0.0
+        self.set_leg_targets(targets)
+        self.set_arm_control(0.0)

@@ -1,0 +1,79 @@
+"""The one lesson factory both domain modules are built with.
+
+A domain is its ``Physics`` class, its ``get_model_and_assets`` and the task class its
+lessons use (:class:`reach.Reach` on the frame, ``QuadrupedReach`` on the quadruped).
+:class:`LessonFactory` turns a task into an environment on the domain's model (control
+timestep ``conventions.CONTROL_TIMESTEP``) and :meth:`LessonFactory.add_lessons`
+registers the curriculum's lessons 1-3 in the domain's ``SUITE``:
+
+* ``lesson1``: reach the target position, eq. 9 reward, fixed initial state;
+* ``lesson2``: reach it with the head level, eq. 10 reward, fixed initial state;
+* ``lesson3``: as lesson 2, each episode starts where the previous one ended.
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import Callable
+
+from dm_control.rl import control
+
+from robostrich_suite import targets
+from robostrich_suite.tasks import reach
+from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
+
+LESSON_TIME_LIMIT = 2.0  # s (250 control steps): the tendon servos bring the neck to rest in ~1.5 s
+
+# name -> (reward, initial state, what the lesson asks)
+LESSONS = {
+    "lesson1": ("lesson1", "fixed", "Lesson 1: position only (eq. 9), from the fixed initial pose"),
+    "lesson2": ("lesson2", "fixed", "Lesson 2: position and level head (eq. 10), from the fixed "
+                                    "initial pose"),
+    "lesson3": ("lesson2", "continue", "Lesson 3: as lesson 2, each episode continues from the "
+                                       "previous final state"),
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class LessonFactory:
+    """Environments of one domain: ``physics`` (a ``Physics`` class) on the model of
+    ``get_model_and_assets(arm_spec, tendon_layout, **model_kwargs)``; lessons use
+    ``reach_task`` (called with ``reward``, ``initial_state``, ``random`` and the task
+    keyword arguments)."""
+    physics: type
+    get_model_and_assets: Callable
+    reach_task: Callable
+
+    def environment(self, task, time_limit, arm_spec, tendon_layout, environment_kwargs,
+                    **model_kwargs) -> control.Environment:
+        time_limit = reach.check_time_limit(time_limit)
+        physics = self.physics.from_xml_string(
+            *self.get_model_and_assets(arm_spec, tendon_layout, **model_kwargs))
+        environment_kwargs = dict(environment_kwargs or {})
+        environment_kwargs.setdefault("control_timestep", CONTROL_TIMESTEP)
+        return control.Environment(physics, task, time_limit=time_limit, **environment_kwargs)
+
+    def lesson(self, reward, initial_state, time_limit, random, environment_kwargs, arm_spec,
+               tendon_layout, task_kwargs, **task_options) -> control.Environment:
+        """A ``reach_task`` environment; warns when the default targets were made with
+        another arm than ``arm_spec``/``tendon_layout``."""
+        if "target_pool" not in task_kwargs:
+            targets.warn_if_other_arm(arm_spec, tendon_layout)
+        task = self.reach_task(reward=reward, initial_state=initial_state, random=random,
+                               **task_options, **task_kwargs)
+        return self.environment(task, time_limit, arm_spec, tendon_layout, environment_kwargs)
+
+    def add_lessons(self, suite, setting: str) -> None:
+        """Register ``lesson1``-``lesson3`` in ``suite`` (tagged ``curriculum``); ``setting``
+        ends each lesson's docstring (", with the quadruped standing.")."""
+        for name, (reward, initial_state, summary) in LESSONS.items():
+            suite.add("curriculum")(self._lesson_factory(name, reward, initial_state,
+                                                          summary + setting))
+
+    def _lesson_factory(self, name, reward, initial_state, doc):
+        def lesson(time_limit=LESSON_TIME_LIMIT, random=None, environment_kwargs=None,
+                   arm_spec=None, tendon_layout=None, **task_kwargs):
+            return self.lesson(reward, initial_state, time_limit, random, environment_kwargs,
+                               arm_spec, tendon_layout, task_kwargs)
+        lesson.__name__ = lesson.__qualname__ = name
+        lesson.__doc__ = doc
+        return lesson

@@ -1,0 +1,271 @@
+"""The ``robostrich_a1`` tasks: the arm on a walking A1-like quadruped (Sec. 4.2, 5.2).
+
+The trunk frame.  Targets, head position and velocities are given in a frame that
+walks with the quadruped: origin on the ground under the trunk centre, x along the
+trunk's heading (projected on the ground), y to its left, z up.  A target
+``(forward, up)`` is thus "this far ahead of the trunk centre, this high above the
+ground": the same meaning while standing (lessons 1-3), while the trunk bobs and
+changes height (lesson 4) and in ``head_stabilize``, where the target *is* ``(P_d,
+height)``.  The head attitude is measured in the trunk's heading plane.  The default
+targets are the ``robostrich`` level-head poses, moved from the frame's neck base to the
+arm mount on the trunk at the standing height.
+
+Observations (Table 2, then the goal and tendon state as in ``robostrich``):
+``head_position`` (3), ``head_velocity`` (3), ``joint_angles`` (18),
+``trunk_position`` (3: x, y walked since the episode start, height above ground),
+``trunk_velocity`` (3, trunk frame), ``target_position`` (2), ``to_target`` (2),
+``attitude_error``, ``head_attitude``, ``tendon_contraction`` (9), ``tendon_tension`` (9).
+The action is the 9 tendon contractions; the legs follow the gait, not the policy.
+
+Timing: control step 0.008 s (the paper's) = 4 physics steps of 0.002 s; the
+open-loop trot with the arm mounted is stable at 2 ms (implicitfast integrator).
+Each episode starts with the quadruped standing still after ``SETTLE_TIME`` of
+physics, so the servos' sag under the robot's weight is not part of the episode.
+The legs' joint targets come from :mod:`robostrich_suite.tasks.gait` (default: replay of
+the shipped gait file ``data/a1_trot.csv``), written to the leg servos in
+``before_step``; the commanded trunk height is raised by the servos' measured sag
+(``gait.SAG_COMPENSATION``) and a small steering loop keeps the walk on its start line
+(``STEER_*``; ``steer=False`` gives the pure open-loop gait).
+
+A fallen quadruped (trunk tilted past 60 deg) or a physics divergence ends the episode.
+
+Run ``robostrich-walk`` to see the perturbation the arm gets.
+"""
+from __future__ import annotations
+
+import collections
+import math
+
+import numpy as np
+
+from robostrich_suite.model import quadruped as quad
+from robostrich_suite.model import scenes
+from robostrich_suite.tasks import gait as gait_lib
+from robostrich_suite.tasks import reach
+
+SETTLE_TIME = 0.2  # s of standing physics before each fresh episode
+LESSON4_TIME_LIMIT = 6.0  # s: stand-in, lowered/raised, back (one height change)
+HEAD_STABILIZE_TIME_LIMIT = 12.0  # s (1500 steps, Fig. 9)
+NARROW_GAP_STEPS_PER_TARGET = 150  # control steps = 1.2 s per sub-target
+FALL_UPRIGHTNESS = 0.5  # trunk z-axis z component below this = fallen over
+# Steering on top of the open-loop gait: an open-loop trot wanders 10-20 deg in yaw
+# and drifts sideways.  Like the real A1's own controller, the task keeps the walk on
+# the +x line through the start: the desired yaw leans back towards the line, and the
+# stride of the left legs is lengthened (right legs shortened) in proportion to the
+# yaw error.
+STEER_YAW_GAIN = 1.0  # stride change (fraction) per rad of yaw error
+STEER_LINE_GAIN = 1.5  # rad of desired yaw per m off the line
+STEER_MAX_YAW = 0.3  # rad
+STEER_MAX_STRIDE_CHANGE = 0.5  # fraction of the stride
+GAP_STOP_DISTANCE = 0.16  # m, the quadruped stops when the arm's base is this close to the wall
+
+# head_stabilize (Sec. 5.2.1): P_d and the head height above ground.
+# A level-head pose of the actuated workspace (frame pose (0.31, 0.27) on the trunk).
+HEAD_STABILIZE_DISTANCE = 0.40  # m ahead of the trunk centre
+HEAD_STABILIZE_HEIGHT = 0.56  # m above the ground
+# Fig. 9A: trunk height lowered during steps 500-750 and raised back during 1000-1250.
+HEAD_STABILIZE_HEIGHTS = gait_lib.TrunkHeightSchedule(
+    times=(0.0, 4.0, 6.0, 8.0, 10.0),
+    heights=(quad.STANDING_TRUNK_HEIGHT, quad.STANDING_TRUNK_HEIGHT, 0.22, 0.22,
+             quad.STANDING_TRUNK_HEIGHT))
+LESSON4_HEIGHT_RANGE = (0.21, 0.30)  # m, random trunk height of the middle of an episode
+
+# The six sub-targets (x from the wall's near face, height above ground), Fig. 10.
+# Heights stay within the level-head workspace: 0.1-0.24 m above the arm's base
+# (0.37 m above ground when standing) and 0.15-0.45 m ahead of it.
+GAP_TARGETS = np.array([
+    [-0.06, 0.45],  # 1: down in front of the wall
+    [0.08, 0.45],  # 2: under the overhang
+    [scenes.GAP_SLOT_X, 0.45],  # 3: the bottom of the gap
+    [scenes.GAP_SLOT_X, scenes.GAP_SHELF_BOTTOM + scenes.GAP_SHELF_THICKNESS / 2],  # 4: in the gap
+    [scenes.GAP_SLOT_X, scenes.GAP_SHELF_BOTTOM + scenes.GAP_SHELF_THICKNESS + 0.03],  # 5: just through it
+    [scenes.GAP_SLOT_X, scenes.GAP_SHELF_BOTTOM + scenes.GAP_SHELF_THICKNESS + 0.07],  # 6: the top target
+])
+
+
+def default_target_pool() -> np.ndarray:
+    """``robostrich``'s level-head training targets, in the trunk frame (module doc)."""
+    from robostrich_suite import targets
+    return frame_to_trunk(targets.training_targets())
+
+
+def frame_to_trunk(frame_targets) -> np.ndarray:
+    """(x, z) head positions of the arm on its frame -> (forward, up) on the standing A1."""
+    frame_targets = reach.as_targets(frame_targets, "targets")
+    return frame_targets + [scenes.MOUNT_OFFSET[0], scenes.NOMINAL_MOUNT_HEIGHT - scenes.FRAME_MOUNT_HEIGHT]
+
+
+_LEFT_SIGN = np.array([1.0 if leg.endswith("L") else -1.0 for leg in quad.LEGS])
+
+
+class _QuadrupedTaskMixin:
+    """What every ``robostrich_a1`` task shares: legs driven by a gait, tendon-only
+    actions, Table 2 observations in the trunk frame, episodes starting from standing.
+
+    Args:
+      legs: ``"stand"`` or ``"walk"``.
+      gait: for walking, a :class:`gait.TrotGait`, a :class:`gait.GaitReplay` or a gait
+        file path (or any object with ``joint_targets(t, trunk_height, stride_scale)``);
+        default: replay of the shipped file.
+      trunk_heights: a :class:`gait.TrunkHeightSchedule`, a callable ``random ->
+        schedule`` (a new schedule each episode), or ``None`` (constant nominal height).
+      steer: keep the walk on the start line (see ``STEER_*``); off = the pure open-loop gait.
+    """
+
+    def __init__(self, *, legs: str = "stand", gait=None, trunk_heights=None, steer: bool = True,
+                 **kwargs):
+        if legs not in ("stand", "walk"):
+            raise ValueError(f"unknown legs {legs!r}; use 'stand' or 'walk'")
+        if legs == "walk":
+            if gait is None:
+                gait = gait_lib.GaitReplay.from_file()
+            elif not hasattr(gait, "joint_targets"):
+                gait = gait_lib.GaitReplay.from_file(gait)
+        elif gait is not None:
+            raise ValueError("gait applies to the walking tasks (lesson4, head_stabilize, narrow_gap); "
+                             "this task's quadruped stands")
+        else:
+            gait = gait_lib.Standing()
+        self.legs = legs
+        self.gait = gait
+        self.steer = bool(steer)
+        self._trunk_heights = trunk_heights
+        self.height_schedule = gait_lib.TrunkHeightSchedule()
+        self._episode_start_time = 0.0
+        self._episode_start_xy = np.zeros(2)
+        super().__init__(**kwargs)
+
+    # Episode.
+    def initialize_episode(self, physics):
+        schedule = self._trunk_heights
+        if callable(schedule) and not isinstance(schedule, gait_lib.TrunkHeightSchedule):
+            schedule = schedule(self.random)
+        self.height_schedule = schedule or gait_lib.TrunkHeightSchedule()
+        continuing = self.initial_state == "continue" and self._last_state is not None
+        if not continuing:
+            physics.place_standing(trunk_height=float(self.height_schedule(0.0)))
+            physics.forward()
+            physics.step(int(round(SETTLE_TIME / physics.model.opt.timestep)))
+        super().initialize_episode(physics)
+        self._episode_start_time = physics.data.time
+        self._episode_start_xy = physics.trunk_position()[:2]
+        self.update_target(physics)
+
+    def episode_time(self, physics) -> float:
+        return physics.data.time - self._episode_start_time
+
+    def trunk_height_command(self, physics) -> float:
+        return float(self.height_schedule(self.episode_time(physics)))
+
+    def command_trunk_height(self, physics, height: float, ramp_time: float = 0.5) -> None:
+        """From now on, move the trunk height command linearly to ``height`` (m) over
+        ``ramp_time`` seconds and hold it (replaces the episode's schedule)."""
+        now = self.episode_time(physics)
+        self.height_schedule = gait_lib.TrunkHeightSchedule(
+            (now, now + max(ramp_time, 1e-6)), (self.trunk_height_command(physics), height))
+
+    def leg_targets(self, physics) -> np.ndarray:
+        t = self.episode_time(physics)
+        height = float(self.height_schedule(t)) + gait_lib.SAG_COMPENSATION[self.legs]
+        scale = self.stride_scale(physics) if self.legs == "walk" and self.steer else None
+        return self.gait.joint_targets(t, height, scale)
+
+    def stride_scale(self, physics) -> np.ndarray:
+        """Per-leg scale of the fore-aft foot travel that turns back onto the walking line."""
+        off_line = physics.trunk_position()[1] - self._episode_start_xy[1]
+        desired = -min(max(STEER_LINE_GAIN * off_line, -STEER_MAX_YAW), STEER_MAX_YAW)
+        hx, hy = physics.heading()
+        error = math.atan2(hy, hx) - desired
+        change = min(max(STEER_YAW_GAIN * error, -STEER_MAX_STRIDE_CHANGE),
+                     STEER_MAX_STRIDE_CHANGE)
+        return 1.0 + change * _LEFT_SIGN  # yawed left (error > 0): left legs step longer
+
+    def before_step(self, action, physics):
+        super().before_step(action, physics)  # tendons: NaN check, clipping (reach.Reach)
+        physics.set_leg_targets(self.leg_targets(physics))
+
+    def after_step(self, physics):
+        super().after_step(physics)
+        self.update_target(physics)
+
+    def update_target(self, physics) -> None:
+        """Hook for targets fixed in the world (``narrow_gap``); others live in the trunk frame."""
+
+    def get_termination(self, physics):
+        if physics.divergence is not None or physics.trunk_uprightness() < FALL_UPRIGHTNESS:
+            return 0.0
+        return None
+
+    # Measurements in the trunk frame.
+    def head_xz(self, physics) -> np.ndarray:
+        return physics.to_trunk_frame(physics.head_position())[[0, 2]]
+
+    def get_observation(self, physics):
+        """Table 2 (head, joints, trunk), then the goal and tendon state (module doc)."""
+        shared = super().get_observation(physics)
+        obs = collections.OrderedDict()
+        obs["head_position"] = physics.to_trunk_frame(physics.head_position())
+        obs["head_velocity"] = physics.to_trunk_frame(physics.head_velocity(), velocity=True)
+        obs["joint_angles"] = shared["joint_angles"]
+        trunk = physics.trunk_position()
+        obs["trunk_position"] = np.array([*(trunk[:2] - self._episode_start_xy), trunk[2]])
+        obs["trunk_velocity"] = physics.to_trunk_frame(physics.trunk_velocity(), velocity=True)
+        for key, value in shared.items():
+            if key not in obs and key not in ("head_position", "head_velocity"):
+                obs[key] = value
+        return obs
+
+
+class QuadrupedReach(_QuadrupedTaskMixin, reach.Reach):
+    """A ``robostrich`` lesson on the quadruped; targets in the trunk frame."""
+
+    def __init__(self, target_pool=None, **kwargs):
+        if target_pool is None:
+            target_pool = default_target_pool()
+        super().__init__(target_pool=target_pool, **kwargs)
+
+
+class NarrowGap(_QuadrupedTaskMixin, reach.Track):
+    """Walk up to the wall, stop, track ``GAP_TARGETS`` (fixed in the world) in order."""
+
+    def __init__(self, stop_distance: float = GAP_STOP_DISTANCE, **kwargs):
+        kwargs.setdefault("targets", GAP_TARGETS)
+        kwargs.setdefault("steps_per_target", NARROW_GAP_STEPS_PER_TARGET)
+        super().__init__(legs="walk", **kwargs)
+        self.stop_distance = float(stop_distance)
+        self.world_targets = np.asarray(self.targets, float) + [scenes.GAP_WALL_X, 0.0]
+        self._stopped_at = None
+
+    def initialize_episode(self, physics):
+        self._stopped_at = None
+        super().initialize_episode(physics)
+
+    def update_target(self, physics) -> None:
+        x, z = self.world_targets[self.target_index]
+        self.target_position = physics.to_trunk_frame([x, 0.0, z])[[0, 2]]
+
+    def leg_targets(self, physics) -> np.ndarray:
+        """Trot until the arm's base is ``stop_distance`` from the wall, then stand
+        (blending from the last trot targets to the standing pose over 0.3 s)."""
+        t = self.episode_time(physics)
+        if self._stopped_at is None and (
+                scenes.GAP_WALL_X - physics.arm_base_position()[0] < self.stop_distance):
+            self._stopped_at = (t, super().leg_targets(physics))
+        if self._stopped_at is None:
+            return super().leg_targets(physics)
+        t_stop, last = self._stopped_at
+        blend = min((t - t_stop) / 0.3, 1.0)
+        standing = gait_lib.Standing().joint_targets(
+            t, self.trunk_height_command(physics) + gait_lib.SAG_COMPENSATION["stand"])
+        return (1 - blend) * last + blend * standing
+
+    def walking(self) -> bool:
+        return self._stopped_at is None
+
+
+def lesson4_heights(random, time_limit: float = LESSON4_TIME_LIMIT,
+                    height_range=LESSON4_HEIGHT_RANGE) -> gait_lib.TrunkHeightSchedule:
+    """Nominal height for the first sixth, ramp to a random height, hold, ramp back."""
+    h0, h1 = quad.STANDING_TRUNK_HEIGHT, float(random.uniform(*height_range))
+    knots = np.array([0.0, 1 / 6, 2 / 6, 4 / 6, 5 / 6]) * time_limit
+    return gait_lib.TrunkHeightSchedule(tuple(knots), (h0, h0, h1, h1, h0))
