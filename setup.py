@@ -1,8 +1,8 @@
 """Installs robostrich_suite (simulation) and agents (JAX SAC learner).
 
 Versions are pinned to a set that works together: mujoco 4.0 breaks
-dm-control 1.0.50 (see ../shared/design.md), and dm-haiku 0.0.17 is the
-last haiku release, tested here with jax 0.10.2.
+dm-control 1.0.50, and dm-haiku 0.0.17 is the last haiku release, tested
+here with jax 0.10.2.
 """
 from setuptools import find_packages, setup
 
@@ -40,6 +40,7 @@ setup(
             "robostrich-workspace = robostrich_suite.studies.workspace:cli",
             "robostrich-layouts = robostrich_suite.studies.layout_compare:cli",
             "robostrich-targets = robostrich_suite.studies.target_generation:cli",
+            "robostrich-gait = robostrich_suite.studies.gait_generation:cli",
         ],
     },
 )

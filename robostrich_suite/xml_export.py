@@ -2,14 +2,12 @@
 
 ``xml/`` lets a user open the robots in plain MuJoCo (``simulate``,
 ``mujoco.MjModel.from_xml_path``) without this package.  A test fails when a
-checked-in file differs from what the generators produce now; regenerate with
-``python tools/export_xml.py``.
+checked-in file differs from what the generators produce now; regenerate from the
+repository's root with ``robostrich-export-xml --out xml``.
 """
 from __future__ import annotations
 
 import pathlib
-
-REPO_XML_DIR = pathlib.Path(__file__).resolve().parent.parent / "xml"
 
 
 def _robostrich():
@@ -27,7 +25,7 @@ def generators() -> dict:
     return {"robostrich.xml": _robostrich, "robostrich_a1.xml": _robostrich_a1}
 
 
-def export(directory: pathlib.Path = REPO_XML_DIR) -> list[pathlib.Path]:
+def export(directory: pathlib.Path) -> list[pathlib.Path]:
     """Write every default model's XML into ``directory``; returns the paths."""
     directory = pathlib.Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
@@ -42,8 +40,8 @@ def export(directory: pathlib.Path = REPO_XML_DIR) -> list[pathlib.Path]:
 def main(argv=None) -> None:
     import argparse
     parser = argparse.ArgumentParser(description="Write the generated MJCF of the default models.")
-    parser.add_argument("--out", type=pathlib.Path, default=REPO_XML_DIR,
-                        help="directory to write into (default: the repository's xml/)")
+    parser.add_argument("--out", type=pathlib.Path, required=True,
+                        help="directory to write into (the checked-in copies: the repository's xml/)")
     args = parser.parse_args(argv)
     for path in export(args.out):
         print(f"wrote {path}")

@@ -96,16 +96,16 @@ def test_ventral_tendons_flex_forward_and_dorsal_tendon_extends_back(physics):
     assert attitude < -30
 
 
-def test_checked_in_xml_is_up_to_date():
+def test_checked_in_xml_is_up_to_date(repo_xml_dir):
     for name, generate in xml_export.generators().items():
-        path = xml_export.REPO_XML_DIR / name
-        assert path.exists(), f"xml/{name} is missing: run python tools/export_xml.py"
+        path = repo_xml_dir / name
+        assert path.exists(), f"xml/{name} is missing: run robostrich-export-xml --out xml"
         assert path.read_text() == generate(), (
-            f"xml/{name} is out of date: run python tools/export_xml.py")
+            f"xml/{name} is out of date: run robostrich-export-xml --out xml")
 
 
-def test_checked_in_xml_loads_in_plain_mujoco():
-    model = mujoco.MjModel.from_xml_path(str(xml_export.REPO_XML_DIR / "robostrich.xml"))
+def test_checked_in_xml_loads_in_plain_mujoco(repo_xml_dir):
+    model = mujoco.MjModel.from_xml_path(str(repo_xml_dir / "robostrich.xml"))
     assert (model.njnt, model.ntendon, model.nu) == (18, 9, 9)
 
 

@@ -126,12 +126,17 @@ def test_the_other_scripts_exit_zero(tmp_path):
                                 "--ramp-time", "0.05", "--no-recording", "--no-progress"],
         "robostrich-workspace": ["--out", tmp_path / "workspace", "--samples", "200", "--edge-samples", "200",
                                  "--actuated-samples", "0", "--no-progress"],
+        "robostrich-gait": ["--out", tmp_path / "gait" / "trot.csv"],
+        "robostrich-targets": ["--samples", "2", "--seek-level-time", "0", "--out", tmp_path / "targets.npz"],
     }
     processes = {name: start(name, *args) for name, args in runs.items()}
-    for name, process in processes.items():
-        assert_succeeded(finish(process))
+    results = {name: finish(process) for name, process in processes.items()}
+    for result in results.values():
+        assert_succeeded(result)
     assert (tmp_path / "movement" / "lever.png").exists() and (tmp_path / "workspace" / "workspace.png").exists()
     assert (tmp_path / "walk" / "walk.png").exists()  # --out is a directory for every command
+    assert (tmp_path / "xml" / "robostrich_a1.xml").exists() and (tmp_path / "gait" / "trot.csv").exists()
+    assert "level-head poses to" in results["robostrich-targets"].stdout
 
 
 def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
@@ -150,6 +155,7 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
         "ramp_negative": start("robostrich-movement", "--ramp-time", "-1", "--out", tmp_path / "mv"),
         "layout": start("robostrich-train", "--layout", "tangled", "--quiet", "--out", tmp_path / "lay"),
         "task": start("robostrich-train", "--plan", "lesson1:10,lesson9:10", "--quiet", "--out", tmp_path / "task"),
+        "xml_no_out": start("robostrich-export-xml"),  # no default: it would write into the installed package
     }
     results = {case: finish(p) for case, p in cases.items()}
     assert_user_error(results["resume_empty"], "--resume", "no checkpoint", str(empty))
@@ -163,7 +169,8 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     assert_user_error(results["layout"], "unknown layout 'tangled'")
     assert_user_error(results["task"], "no task 'lesson9'")
     assert not (tmp_path / "lay").exists() and not (tmp_path / "task").exists()
-    for case in ("resume_empty", "truncated", "empty", "ramp_negative", "layout", "task"):
+    assert_user_error(results["xml_no_out"], "--out")
+    for case in ("resume_empty", "truncated", "empty", "ramp_negative", "layout", "task", "xml_no_out"):
         assert results[case].returncode == 2, (case, results[case].stderr)
 
 

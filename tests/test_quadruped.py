@@ -1,4 +1,4 @@
-"""The A1-like quadruped: design.md's facts, and it walks with the arm on it."""
+"""The A1-like quadruped: the public A1 facts, and it walks with the arm on it."""
 import numpy as np
 import pytest
 from dm_control import mjcf

@@ -225,10 +225,10 @@ def test_narrow_gap_wall_blocks_the_head():
     assert contacts > 0 and free_contacts == 0
 
 
-def test_checked_in_xml_is_the_generated_model_and_loads_in_plain_mujoco():
-    path = xml_export.REPO_XML_DIR / "robostrich_a1.xml"
+def test_checked_in_xml_is_the_generated_model_and_loads_in_plain_mujoco(repo_xml_dir):
+    path = repo_xml_dir / "robostrich_a1.xml"
     assert path.read_text() == a1.get_model_and_assets()[0], (
-        "xml/robostrich_a1.xml is out of date: run python tools/export_xml.py")
+        "xml/robostrich_a1.xml is out of date: run robostrich-export-xml --out xml")
     model = mujoco.MjModel.from_xml_path(str(path))
     assert model.nu == 21 and model.nq == 7 + 12 + 18
     assert model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE

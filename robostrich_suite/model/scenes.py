@@ -20,6 +20,18 @@ from robostrich_suite.tasks.conventions import PHYSICS_TIMESTEP
 FRAME_HEIGHT = 0.05  # m, top of the immobile frame, where the arm's base sits
 
 
+def _set_up_world(model: mjcf.RootElement, texrepeat: int) -> None:
+    """What every scene shares: the physics timestep and integrator, the headlight and the
+    checker floor material (repeated ``texrepeat`` times)."""
+    model.option.timestep = PHYSICS_TIMESTEP
+    model.option.integrator = "implicitfast"
+    model.visual.headlight.set_attributes(ambient=[0.4, 0.4, 0.4], diffuse=[0.6, 0.6, 0.6])
+    model.asset.add("texture", name="grid", type="2d", builtin="checker", width=256, height=256,
+                    rgb1=[0.2, 0.3, 0.4], rgb2=[0.25, 0.35, 0.45])
+    model.asset.add("material", name="grid", texture="grid", texrepeat=[texrepeat, texrepeat],
+                    reflectance=0.1)
+
+
 def build_frame_arm(spec: arm_lib.ArmSpec | None = None, layout: arm_lib.TendonLayout | None = None,
                     base_height: float = FRAME_HEIGHT) -> mjcf.RootElement:
     """The arm on an immobile frame (the paper's first setup), neck pointing up.
@@ -30,12 +42,7 @@ def build_frame_arm(spec: arm_lib.ArmSpec | None = None, layout: arm_lib.TendonL
     spec = spec or arm_lib.ArmSpec.from_table1()
     arena = mjcf.RootElement(model="robostrich")
     arena.compiler.angle = "radian"
-    arena.option.timestep = PHYSICS_TIMESTEP
-    arena.option.integrator = "implicitfast"
-    arena.visual.headlight.set_attributes(ambient=[0.4, 0.4, 0.4], diffuse=[0.6, 0.6, 0.6])
-    arena.asset.add("texture", name="grid", type="2d", builtin="checker", width=256, height=256,
-                    rgb1=[0.2, 0.3, 0.4], rgb2=[0.25, 0.35, 0.45])
-    arena.asset.add("material", name="grid", texture="grid", texrepeat=[8, 8], reflectance=0.1)
+    _set_up_world(arena, texrepeat=8)
     arena.worldbody.add("light", pos=[0, -1, 2], dir=[0, 1, -1])
     arena.worldbody.add("geom", name="floor", type="plane", size=[2, 2, 0.05], material="grid",
                         pos=[0, 0, -0.4])
@@ -95,12 +102,7 @@ def build_a1(arm_spec=None, tendon_layout=None, scene: str = "flat") -> mjcf.Roo
     trunk.pos = [0, 0, quad.standing_hip_height()]
     trunk.insert("freejoint", 0, name="root")
 
-    model.option.timestep = PHYSICS_TIMESTEP
-    model.option.integrator = "implicitfast"
-    model.visual.headlight.set_attributes(ambient=[0.4, 0.4, 0.4], diffuse=[0.6, 0.6, 0.6])
-    model.asset.add("texture", name="grid", type="2d", builtin="checker", width=256, height=256,
-                    rgb1=[0.2, 0.3, 0.4], rgb2=[0.25, 0.35, 0.45])
-    model.asset.add("material", name="grid", texture="grid", texrepeat=[20, 20], reflectance=0.1)
+    _set_up_world(model, texrepeat=20)
     model.worldbody.insert("light", 0, pos=[0, -1, 3], dir=[0, 0.3, -1])
     model.worldbody.insert("geom", 1, name="floor", type="plane", size=[10, 10, 0.1],
                            material="grid", friction=[1.0, 0.005, 0.0001])

@@ -4,6 +4,7 @@
 * :mod:`movement` (``robostrich-movement``): the rolling and lever patterns (Figs. 3-5);
 * :mod:`walk` (``robostrich-walk``): the quadruped walking with the arm on it;
 * :mod:`target_generation` (``robostrich-targets``): the level-head target files;
+* :mod:`gait_generation` (``robostrich-gait``): the gait file of the open-loop trot;
 * :mod:`layout_compare` (``robostrich-layouts``) with :mod:`coverage`, :mod:`pose_seek`
   and :mod:`layout_figure`: tendon layouts compared.
 

@@ -10,7 +10,7 @@ reaches less than the kinematic region, so the paper's blue region contains
 targets the arm cannot hold.  The actuated level-head subset is therefore the
 one source of the tasks' targets (see :mod:`robostrich_suite.targets`).
 
-    python tools/workspace.py --out out/workspace   # Fig. 6 + actuated overlay, samples .npz
+    robostrich-workspace --out out/workspace   # Fig. 6 + actuated overlay, samples .npz
 """
 from __future__ import annotations
 

@@ -29,11 +29,11 @@ repeat the first (the shipped file ``data/a1_trot.csv`` does).  A malformed
 file raises ``ValueError`` naming the line and column.
 
 Regenerate the shipped file with
-``python -m robostrich_suite.tasks.gait --out robostrich_suite/data/a1_trot.csv``.
+``robostrich-gait --out robostrich_suite/data/a1_trot.csv``
+(:mod:`robostrich_suite.studies.gait_generation`).
 """
 from __future__ import annotations
 
-import argparse
 import bisect
 import csv
 import dataclasses
@@ -369,34 +369,3 @@ def write_gait_file(path, times, targets, comment: str | None = None) -> None:
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(out.getvalue())
-
-
-def sample_trot(gait: TrotGait | None = None, cycles: int = 1, rate: float = 100.0):
-    """Sample ``cycles`` periods of a trot at ``rate`` Hz, last sample = first (closed loop)."""
-    gait = gait or TrotGait()
-    count = int(round(cycles * gait.period * rate))
-    times = np.linspace(0.0, cycles * gait.period, count + 1)
-    return times, gait.joint_targets(times)
-
-
-def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description="Write a trot as a gait file (CSV).")
-    parser.add_argument("--out", type=pathlib.Path, required=True,
-                        help="gait file to write (the shipped one: robostrich_suite/data/a1_trot.csv)")
-    parser.add_argument("--frequency", type=float, default=TrotGait.frequency)
-    parser.add_argument("--stride", type=float, default=TrotGait.stride)
-    parser.add_argument("--lift", type=float, default=TrotGait.lift)
-    parser.add_argument("--trunk-height", type=float, default=TrotGait.trunk_height)
-    parser.add_argument("--rate", type=float, default=100.0, help="samples per second")
-    args = parser.parse_args(argv)
-    gait = TrotGait(args.frequency, args.stride, args.lift, args.trunk_height)
-    times, targets = sample_trot(gait, rate=args.rate)
-    write_gait_file(args.out, times, targets, comment=(
-        f"A1-like trot from robostrich_suite.tasks.gait.TrotGait: frequency {gait.frequency} Hz, "
-        f"stride {gait.stride} m, lift {gait.lift} m, trunk height {gait.trunk_height} m.\n"
-        "Columns: time (s), then 12 joint targets (rad). Loops with period time[-1] - time[0]."))
-    print(f"wrote {len(times)} samples to {args.out}")
-
-
-if __name__ == "__main__":
-    main()
