@@ -6,8 +6,6 @@ the BoundedArray spec (e.g. tendon contractions in metres) and back.
 import jax
 import numpy as np
 
-from agents.sac.networks import SACNetworks
-
 
 class ActionAdapter:
     """Affine map between the policy's [-1, 1] box and the environment's bounds."""
@@ -71,7 +69,9 @@ class Actor:
     carried inside the jitted call, so a step costs one dispatch.
     """
 
-    def __init__(self, networks: SACNetworks, adapter: ActionAdapter, params, key=None, deterministic=False):
+    def __init__(self, networks, adapter: ActionAdapter, params, key=None, deterministic=False):
+        """`networks`: anything with `sample(params, obs, key) -> (action, log_prob)` and `mode(params, obs)`
+        on batches (e.g. agents.sac.SACNetworks)."""
         self.adapter = adapter
         self.params = params
         self.deterministic = deterministic

@@ -133,7 +133,7 @@ class CurriculumRun:
         loop = self.loop
         env_blob = None
         try:
-            env_blob = zlib.compress(pickle.dumps((loop.env, loop.timestep, loop._obs), pickle.HIGHEST_PROTOCOL), 1)
+            env_blob = zlib.compress(pickle.dumps(loop.episode_state(), pickle.HIGHEST_PROTOCOL), 1)
         except Exception as e:  # documented fallback: resume then resets the episode
             env_blob = None
             print(f"warning: environment is not picklable ({e}); a resume will start a fresh episode")
@@ -161,9 +161,7 @@ class CurriculumRun:
         loop.replay.load_state_dict(state["replay"])
         self.lesson_index, self.lesson_steps = state["lesson_index"], state["lesson_steps"]
         if state["environment"] is not None:
-            env, timestep, obs = pickle.loads(zlib.decompress(state["environment"]))
-            loop.set_environment(env, close_episode=False)
-            loop.timestep, loop._obs = timestep, obs
+            loop.resume_episode(*pickle.loads(zlib.decompress(state["environment"])))
         elif not self.done:
             loop.set_environment(self._make_lesson_env(self.lesson_index), close_episode=False)
         loop.load_state_dict(state["loop"])

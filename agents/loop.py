@@ -13,12 +13,14 @@ from agents import probes
 from agents.actors import Actor
 from agents.goals import GoalRelabeler
 from agents.replay import ObservationFlattener, ReplayBuffer
-from agents.sac.config import SACConfig
-from agents.sac.learning import SACLearner
 
 
 class EnvironmentLoop:
-    def __init__(self, env, actor: Actor, replay: ReplayBuffer, learner: SACLearner, config: SACConfig,
+    """Generic over the learner: anything with `step(batches) -> metrics` and `policy_params`; `config` gives
+    the loop's schedule (action_repeat, min_replay_size, env_steps_per_call, updates_per_call, batch_size,
+    her_ratio, relabel_rewards), e.g. an agents.sac.SACConfig."""
+
+    def __init__(self, env, actor: Actor, replay: ReplayBuffer, learner, config,
                  flattener: ObservationFlattener, seed: int = 0, label: str = ""):
         self.actor, self.replay, self.learner, self.config = actor, replay, learner, config
         self.flattener = flattener
@@ -47,6 +49,16 @@ class EnvironmentLoop:
         if close_episode:
             self.replay.end_episode()
         self._set_env(env)
+
+    def episode_state(self):
+        """(environment, last timestep, its flattened observation): what a checkpoint needs to resume
+        the open episode exactly."""
+        return self.env, self.timestep, self._obs
+
+    def resume_episode(self, env, timestep, flat_obs):
+        """Continue the open episode of a checkpointed environment (see `episode_state`)."""
+        self.set_environment(env, close_episode=False)
+        self.timestep, self._obs = timestep, flat_obs
 
     def _act(self, flat_obs):
         if len(self.replay) < self.config.min_replay_size:

@@ -8,7 +8,7 @@ from typing import Mapping
 
 import numpy as np
 
-from agents.sac.learning import Transitions
+from agents.types import Transitions
 
 
 class ObservationFlattener:

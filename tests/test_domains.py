@@ -90,3 +90,15 @@ def test_a_layout_is_part_of_the_checkpoint(tmp_path):
         other.restore(run.checkpoint_path)
     with pytest.raises(ValueError, match="arm domains"):
         CurriculumRun(parse_plan("reacher/easy:10"), TINY, 0, str(tmp_path / "r"), layout=LAYOUT)
+
+
+def test_periodic_evaluation_targets_spread_over_the_held_out_set():
+    """The periodic evaluation's 20 targets reach the upper workspace: the first 20 of `antagonist_pairs`'
+    44 (generation order) hold none of its upper third, where a policy can fail unseen."""
+    full = Domain("robostrich", LAYOUT).heldout_targets()
+    subset = Domain("robostrich", LAYOUT).heldout_targets(20)
+    assert len(subset) == 20 and len(np.unique(subset, axis=0)) == 20
+    np.testing.assert_array_equal(subset[[0, -1]], full[[0, -1]])
+    upper = np.percentile(full[:, 1], 67)
+    assert (subset[:, 1] > upper).sum() >= 5
+    np.testing.assert_array_equal(Domain("robostrich").heldout_targets(100), Domain("robostrich").heldout_targets())

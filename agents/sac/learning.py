@@ -12,17 +12,8 @@ import numpy as np
 import optax
 
 from agents.sac.config import SACConfig
+from agents.types import Transitions  # noqa: F401  (re-exported: the learner consumes them)
 from agents.sac.networks import SACNetworks
-
-
-class Transitions(NamedTuple):
-    """A batch of (s, a, r, discount, s'); `action` is in the policy's [-1, 1] space."""
-
-    obs: jnp.ndarray
-    action: jnp.ndarray
-    reward: jnp.ndarray
-    discount: jnp.ndarray
-    next_obs: jnp.ndarray
 
 
 class TrainingState(NamedTuple):
