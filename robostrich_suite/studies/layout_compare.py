@@ -336,7 +336,7 @@ def main(argv=None) -> dict:
                         help="built-in layouts to compare (default: all of them)")
     parser.add_argument("--layout-file", nargs="+", default=[], type=pathlib.Path, metavar="FILE",
                         help="also compare layouts from JSON/TOML files (see "
-                             "robostrich_suite/layouts.py for the format)")
+                             "robostrich_suite/model/layouts.py for the format)")
     parser.add_argument("--stiffness", nargs="+", type=_positive_float, default=[],
                         metavar="N_M_PER_RAD",
                         help="passive joint stiffnesses to sweep, every layout at each "

@@ -485,7 +485,7 @@ def main(argv=None) -> dict:
                     "{pattern}.png (tendon inputs, head attitude, stick figures) and "
                     "{pattern}.rrd (open with `rerun FILE`). The defaults show the paper's "
                     "difference; --paper-layout runs the same test on the tasks' arm, where "
-                    "it does not appear (see robostrich_suite/movement.py).")
+                    "it does not appear (see docs/movement.md).")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/movement"),
                         help="output directory (default: %(default)s)")
     parser.add_argument("--patterns", nargs="+", choices=PATTERNS, default=list(PATTERNS))
