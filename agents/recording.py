@@ -26,25 +26,15 @@ class RolloutRecorder:
         self.head_path: List[list] = []
         self.targets: List[list] = []
         self.step = 0
-        self._arm_logger = None
-        self._arm_logger_checked = False
+        self._geometry_logged = False
 
     def _log_arm(self, env):
         """Arm shapes via robostrich_suite.rerun_log (geometry once, body poses per step)."""
-        physics = env.physics
-        if not self._arm_logger_checked:
-            self._arm_logger_checked = True
-            try:
-                from robostrich_suite import rerun_log
-                self._arm_logger = rerun_log
-                rerun_log.log_geometry(self.rec, physics)
-            except ImportError:
-                self._arm_logger = None
-        if self._arm_logger is not None:
-            self._arm_logger.log_body_poses(self.rec, physics)
-        else:
-            xpos = np.asarray(physics.data.xpos[1:], np.float64)
-            self.rec.log("world/arm", rr.LineStrips3D([xpos], radii=0.005))
+        from robostrich_suite import rerun_log
+        if not self._geometry_logged:
+            self._geometry_logged = True
+            rerun_log.log_geometry(self.rec, env.physics)
+        rerun_log.log_body_poses(self.rec, env.physics)
 
     def log_step(self, env, action, timestep, position_error=None, attitude_error=None):
         physics, rec = env.physics, self.rec
