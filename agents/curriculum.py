@@ -14,10 +14,9 @@ from typing import Callable, List, Optional, Sequence
 import numpy as np
 
 from agents import checkpoint
+from agents.domains import as_domain
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
-
-from agents.domains import as_domain
 
 
 @dataclasses.dataclass(frozen=True)
@@ -47,6 +46,18 @@ def parse_plan(text: str, default_domain: str = "robostrich") -> List[Lesson]:
 
 def format_plan(plan: Sequence[Lesson]) -> str:
     return ",".join(f"{l.domain}/{l.task}:{l.steps}" for l in plan)
+
+
+def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, task_kwargs: Optional[dict] = None,
+                 layout: Optional[str] = None) -> dict:
+    """What makes two runs the same run: the part of a checkpoint's fingerprint known before building it
+    (robostrich-train checks a resume against it before touching anything)."""
+    identity = {"config": config.to_dict(), "plan": format_plan(plan), "seed": seed}
+    if task_kwargs:
+        identity["task_kwargs"] = dict(task_kwargs)
+    if layout is not None:
+        identity["layout"] = layout
+    return identity
 
 
 def make_environment(domain, task: str, seed: int, **task_kwargs):
@@ -120,14 +131,9 @@ class CurriculumRun:
 
     # -- checkpoints -----------------------------------------------------------------------
     def fingerprint(self) -> dict:
-        fingerprint = {"config": self.config.to_dict(), "plan": format_plan(self.plan), "seed": self.seed,
-                       "observation_layout": self.loop.flattener.describe(),
-                       "action_size": self.loop.actor.adapter.size}
-        if self.task_kwargs:
-            fingerprint["task_kwargs"] = self.task_kwargs
-        if self.layout is not None:
-            fingerprint["layout"] = self.layout
-        return fingerprint
+        return {**run_identity(self.plan, self.config, self.seed, self.task_kwargs, self.layout),
+                "observation_layout": self.loop.flattener.describe(),
+                "action_size": self.loop.actor.adapter.size}
 
     def state_dict(self) -> dict:
         loop = self.loop

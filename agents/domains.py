@@ -41,10 +41,7 @@ class Domain:
                 raise ValueError(f"--layout applies to the arm domains {list(arm_domains())}, "
                                  f"not to {self.name!r}")
             from robostrich_suite.model import layouts
-            if self.layout not in layouts.BUILT_IN:
-                raise ValueError(f"unknown layout {self.layout!r}; built-in layouts are "
-                                 f"{list(layouts.BUILT_IN)}")
-            layouts.target_file(self.layout)  # FileNotFoundError naming the layouts that ship targets
+            layouts.target_file(self.layout)  # names the built-in layouts, or those that ship targets
 
     # -- what kind of domain -----------------------------------------------------------------
     @property
@@ -76,8 +73,7 @@ class Domain:
     # -- environments ------------------------------------------------------------------------
     def _target_file(self):
         from robostrich_suite.model import layouts
-        from robostrich_suite import targets
-        return targets.DATA_PATH if self.layout is None else layouts.target_file(self.layout)
+        return layouts.target_file(self.layout or layouts.DEFAULT)
 
     def _to_domain_frame(self, frame_targets) -> np.ndarray:
         """Targets of the frame arm in this domain's coordinates (the trunk frame on the quadruped)."""

@@ -237,8 +237,8 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
     from agents.lookup import LABEL, LookupPolicy
     from agents.replay import ObservationFlattener
     flattener = ObservationFlattener(make_environment(domain, heldout_task, 0).observation_spec())
-    return evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain, heldout_task, track_task,
-                          num_targets, env_steps=0, record=record, action_repeat=1)
+    return evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain,
+                          heldout_task, track_task, num_targets, env_steps=0, record=record, action_repeat=1)
 
 
 def write_text(path: str, text: str) -> None:

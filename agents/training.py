@@ -24,7 +24,7 @@ from typing import Optional
 import numpy as np
 
 from agents import evaluation
-from agents.curriculum import CurriculumRun, Lesson, format_plan, parse_plan
+from agents.curriculum import CurriculumRun, Lesson, format_plan, parse_plan, run_identity
 from agents.domains import Domain
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
@@ -366,11 +366,7 @@ def main(argv=None):
         from agents import checkpoint
         for label in existing:
             path = os.path.join(args.out, label, "checkpoint.pkl")
-            expected = {"config": config.to_dict(), "plan": format_plan(run_plans[label]), "seed": args.seed}
-            if args.task_kwargs:
-                expected["task_kwargs"] = args.task_kwargs
-            if args.layout is not None:
-                expected["layout"] = args.layout
+            expected = run_identity(run_plans[label], config, args.seed, args.task_kwargs, args.layout)
             stored = checkpoint.read_fingerprint(path)
             checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
     os.makedirs(args.out, exist_ok=True)

@@ -12,8 +12,8 @@ import numpy as np
 import optax
 
 from agents.sac.config import SACConfig
-from agents.types import Transitions  # noqa: F401  (re-exported: the learner consumes them)
 from agents.sac.networks import SACNetworks
+from agents.types import Transitions  # noqa: F401  (re-exported: the learner consumes them)
 
 
 class TrainingState(NamedTuple):

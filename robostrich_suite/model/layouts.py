@@ -107,16 +107,22 @@ BUILT_IN = {f.__name__: BuiltIn(f) for f in (paper, ventral_slips, second_dorsal
 DEFAULT = "paper"  # the tasks' layout
 
 
-def build(name: str, spec: arm_lib.ArmSpec | None = None) -> arm_lib.TendonLayout:
-    """The built-in layout ``name`` on ``spec`` (default: Table 1's arm)."""
+def check_built_in(name: str) -> None:
+    """ValueError naming the built-in layouts if ``name`` is not one of them."""
     if name not in BUILT_IN:
         raise ValueError(f"unknown layout {name!r}; built-in layouts are {list(BUILT_IN)}")
+
+
+def build(name: str, spec: arm_lib.ArmSpec | None = None) -> arm_lib.TendonLayout:
+    """The built-in layout ``name`` on ``spec`` (default: Table 1's arm)."""
+    check_built_in(name)
     return BUILT_IN[name].factory(spec or arm_lib.ArmSpec.from_table1())
 
 
 def target_file(name: str) -> pathlib.Path:
     """The shipped level-pose target file of a built-in layout (``targets.generate``'s
     format): pass ``targets.training_targets(target_file(name))`` as ``target_pool``."""
+    check_built_in(name)
     if name == DEFAULT:
         from robostrich_suite import targets
         return targets.DATA_PATH
