@@ -115,6 +115,25 @@ def test_reward_weights_are_task_kwargs():
     assert rewards.lesson2_reward(0.0, 0.0, 0.05, 5.0) == 0.0
 
 
+def test_precision_term_pays_inside_the_tolerance():
+    """Eq. 10 pays 2 per metre inside 5 cm; the optional Gaussian term makes 1 cm clearly
+    better than 3 cm, equals eq. 10 at 0 weight, and the array form agrees."""
+    plain = rewards.RewardWeights()
+    precise = rewards.RewardWeights(position_precision=1.0, precision_scale=0.01)
+    errors = np.array([0.0, 0.01, 0.03, 0.2])
+    eq10 = [rewards.lesson2_reward(e, 1.0, 0.05, 5.0, plain) for e in errors]
+    with_term = [rewards.lesson2_reward(e, 1.0, 0.05, 5.0, precise) for e in errors]
+    np.testing.assert_allclose(np.subtract(eq10, with_term),
+                               [0.0, 1 - np.exp(-0.5), 1 - np.exp(-4.5), 1.0], atol=1e-9)
+    assert with_term[1] - with_term[2] > 0.5 > eq10[1] - eq10[2]
+    np.testing.assert_allclose(rewards.lesson2_rewards(errors, np.ones(4), 0.05, 5.0, precise),
+                               with_term)
+    with pytest.raises(ValueError, match="precision_scale"):
+        rewards.RewardWeights(precision_scale=0.0)
+    with pytest.raises(ValueError, match="position_precision"):
+        rewards.RewardWeights(position_precision=float("nan"))
+
+
 def _rollout(seed, actions):
     env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=seed))
     ts = env.reset()

@@ -18,11 +18,32 @@ class RewardWeights:
     outside the tolerance); ``position_error`` (per metre) and
     ``attitude_error`` (per degree) weigh the shaping terms.  The defaults make
     a 0.1 m miss and a 10 deg miss cost about the same.
+
+    ``position_precision`` is not in the paper (0 recovers eq. 10): it weighs a
+    Gaussian term ``1 - exp(-e^2 / (2 s^2))`` with ``s = precision_scale`` (m),
+    which keeps paying for precision inside the tolerance, where eq. 10 pays
+    only its 2 per metre shaping.
     """
     position_miss: float = 1.0
     attitude_miss: float = 1.0
     position_error: float = 2.0
     attitude_error: float = 0.02
+    position_precision: float = 0.0
+    precision_scale: float = 0.01
+
+    def __post_init__(self):
+        for field in dataclasses.fields(self):
+            value = getattr(self, field.name)
+            if not (np.isfinite(value) and value >= 0):
+                raise ValueError(f"reward weight {field.name} must be a finite number >= 0, got {value}")
+        if self.precision_scale <= 0:
+            raise ValueError(f"precision_scale must be > 0 m, got {self.precision_scale}")
+
+    def precision_penalty(self, position_error):
+        """The Gaussian precision term (0 at the target, ``position_precision`` far away)."""
+        position_error = np.asarray(position_error, np.float64)
+        return self.position_precision * (
+            1.0 - np.exp(-0.5 * (position_error / self.precision_scale) ** 2))
 
 
 def lesson1_reward(position_error: float, position_tolerance: float) -> float:
@@ -38,7 +59,7 @@ def lesson2_reward(position_error: float, attitude_error_deg: float, position_to
     r_m2 = (-weights.position_miss * float(position_error > position_tolerance)
             - weights.attitude_miss * float(attitude_error_deg > attitude_tolerance_deg))
     r_a2 = -weights.position_error * position_error - weights.attitude_error * attitude_error_deg
-    return r_m2 + r_a2
+    return r_m2 + r_a2 - float(weights.precision_penalty(position_error))
 
 
 def lesson1_rewards(position_error, position_tolerance: float) -> np.ndarray:
@@ -54,4 +75,5 @@ def lesson2_rewards(position_error, attitude_error_deg, position_tolerance: floa
     attitude_error_deg = np.abs(np.asarray(attitude_error_deg, np.float64))
     return (-weights.position_miss * (position_error > position_tolerance)
             - weights.attitude_miss * (attitude_error_deg > attitude_tolerance_deg)
-            - weights.position_error * position_error - weights.attitude_error * attitude_error_deg)
+            - weights.position_error * position_error - weights.attitude_error * attitude_error_deg
+            - weights.precision_penalty(position_error))
