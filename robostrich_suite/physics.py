@@ -49,11 +49,9 @@ class ArmIndices(NamedTuple):
     head_velocity: int  # sensordata address of the head's linear velocity
     servo_gain: np.ndarray  # kp of each tendon servo
     servo_bias: np.ndarray  # kp * rest length of each tendon servo
-
-    @property
-    def rest_lengths(self) -> np.ndarray:
-        """Length of each tendon in the straight pose (m): the servo's zero contraction."""
-        return self.servo_bias / self.servo_gain  # (kp * rest) / kp, fixed at model creation
+    # Length of each tendon in the straight pose (m): the servo's zero contraction,
+    # (kp * rest) / kp, fixed at model creation (randomisation scales kp and bias together).
+    rest_lengths: np.ndarray
 
 
 def arm_indices(model) -> ArmIndices:
@@ -65,12 +63,13 @@ def arm_indices(model) -> ArmIndices:
     actuators = arm_ids(model, "actuator")
     head_site = int(model.name2id(arm_lib.HEAD_SITE_PATH, "site"))
     sensor = model.name2id(f"{arm_lib.ARM_MODEL_NAME}/{arm_lib.HEAD_VELOCITY_SENSOR}", "sensor")
+    servo_gain = -model.actuator_gainprm[actuators, 0].copy()
+    servo_bias = model.actuator_biasprm[actuators, 0].copy()
     return ArmIndices(joints, np.array(model.jnt_qposadr[joints]),
                       np.array(model.jnt_dofadr[joints]), actuators,
                       np.array(model.actuator_trnid[actuators, 0], dtype=int), head_site,
                       int(model.site_bodyid[head_site]), int(model.sensor_adr[sensor]),
-                      -model.actuator_gainprm[actuators, 0].copy(),
-                      model.actuator_biasprm[actuators, 0].copy())
+                      servo_gain, servo_bias, servo_bias / servo_gain)
 
 
 def tendon_sides(model) -> list[str]:
@@ -141,7 +140,17 @@ def attitude_error_deg(attitude_deg, desired_deg):
     as at +90); the error is about where the head points, so it is taken
     modulo a turn.  Its magnitude is continuous everywhere, so are rewards on it.
     """
+    if isinstance(attitude_deg, float):  # one reading (the per-step path): plain floats, same result
+        return (attitude_deg - desired_deg + 180.0) % 360.0 - 180.0
     return (np.asarray(attitude_deg) - desired_deg + 180.0) % 360.0 - 180.0
+
+
+def _continuous_attitude(axis_angle_rad: float, joint_angles_rad: np.ndarray) -> float:
+    """:func:`continuous_attitude_deg` of one pose in plain floats (same result): the
+    physics accessors run it twice per control step."""
+    axis_angle = math.degrees(axis_angle_rad)
+    turns = (math.degrees(joint_angles_rad.sum()) - axis_angle) / 360.0
+    return axis_angle + 360.0 * round(turns) if math.isfinite(turns) else math.nan
 
 
 def head_attitude_deg(physics) -> float:
@@ -182,13 +191,20 @@ class ArmPhysicsMixin:
     episodes_started: int = 0
     episodes_diverged: int = 0
 
-    # Indices are looked up once per model; the model never changes under a Physics.
+    # Indices are looked up once per model.  dm_control swaps the model only through
+    # ``_reload_from_data`` (construction, reload, copy, unpickling), which forgets them
+    # and binds the raw ``mujoco`` structs: the per-step accessors read those directly,
+    # skipping dm_control's wrapper properties (a Python call per field read).
+    def _reload_from_data(self, data):
+        self.__dict__["_arm_index_cache"] = None
+        super()._reload_from_data(data)
+        self.__dict__["_raw_model"], self.__dict__["_raw_data"] = data.model.ptr, data.ptr
+
     def _arm_indices(self) -> ArmIndices:
-        cache = self.__dict__.get("_arm_index_cache")
-        if cache is None or cache[0] is not self.model.ptr:
-            cache = (self.model.ptr, arm_indices(self.model))
-            self.__dict__["_arm_index_cache"] = cache
-        return cache[1]
+        indices = self.__dict__.get("_arm_index_cache")
+        if indices is None:
+            indices = self.__dict__["_arm_index_cache"] = arm_indices(self.model)
+        return indices
 
     def arm_joint_names(self) -> list[str]:
         return [self.model.id2name(int(j), "joint") for j in self._arm_indices().joints]
@@ -196,29 +212,30 @@ class ArmPhysicsMixin:
     def tendon_names(self) -> list[str]:
         return [self.model.id2name(int(i), "actuator") for i in self._arm_indices().actuators]
 
+    # Fancy indexing (by an index array) returns a new array: no .copy() after it.
     def head_position(self) -> np.ndarray:
         """Head site position (x, y, z) in metres, world frame."""
-        return self.data.site_xpos[self._arm_indices().head_site].copy()
+        return self._raw_data.site_xpos[self._arm_indices().head_site].copy()
 
     def head_velocity(self) -> np.ndarray:
         """Head site linear velocity (x, y, z) in m/s, world frame."""
         adr = self._arm_indices().head_velocity
-        return self.data.sensordata[adr:adr + 3].copy()
+        return self._raw_data.sensordata[adr:adr + 3].copy()
 
     def head_attitude(self) -> float:
         """Head attitude in degrees: 90 = head parallel to the ground (paper Fig. 2B); continuous
         past 180 (no wrap), see :func:`continuous_attitude_deg`."""
-        xmat = self.data.xmat[self._arm_indices().head_body]  # row-major 3x3; column 2 = head axis
-        return float(continuous_attitude_deg(np.degrees(np.arctan2(xmat[2], xmat[8])),
-                                                     self.data.qpos[self._arm_indices().qpos]))
+        indices, data = self._arm_indices(), self._raw_data
+        xmat = data.xmat[indices.head_body]  # row-major 3x3; column 2 = head axis
+        return _continuous_attitude(math.atan2(xmat[2], xmat[8]), data.qpos[indices.qpos])
 
     def joint_angles(self) -> np.ndarray:
         """The 18 joint angles (rad), atlas first; positive = ventral flexion."""
-        return self.data.qpos[self._arm_indices().qpos].copy()
+        return self._raw_data.qpos[self._arm_indices().qpos]
 
     def tendon_lengths(self) -> np.ndarray:
         """Current length of each actuated tendon (m), in action order."""
-        return self.data.ten_length[self._arm_indices().tendons].copy()
+        return self._raw_data.ten_length[self._arm_indices().tendons]
 
     def tendon_rest_lengths(self) -> np.ndarray:
         """Length of each tendon in the straight pose (m): the servo's zero contraction."""
@@ -226,26 +243,27 @@ class ArmPhysicsMixin:
 
     def tendon_contractions(self) -> np.ndarray:
         """How much each tendon is shorter than at rest (m)."""
-        return self.tendon_rest_lengths() - self.tendon_lengths()
+        indices = self._arm_indices()
+        return indices.rest_lengths - self._raw_data.ten_length[indices.tendons]
 
     def tendon_forces(self) -> np.ndarray:
         """Pull in each tendon (N, >= 0), in action order."""
-        return -self.data.actuator_force[self._arm_indices().actuators].copy()
+        return -self._raw_data.actuator_force[self._arm_indices().actuators]
 
     def tendon_max_forces(self) -> np.ndarray:
         """Largest pull of each tendon's actuator (N, > 0), in action order."""
-        return -self.model.actuator_forcerange[self._arm_indices().actuators, 0]
+        return -self._raw_model.actuator_forcerange[self._arm_indices().actuators, 0]
 
     def arm_control(self) -> np.ndarray:
-        return self.data.ctrl[self._arm_indices().actuators].copy()
+        return self._raw_data.ctrl[self._arm_indices().actuators]
 
     def arm_control_range(self) -> np.ndarray:
         """(9, 2) low/high tendon contractions (m): the action spec's bounds."""
-        return self.model.actuator_ctrlrange[self._arm_indices().actuators]
+        return self._raw_model.actuator_ctrlrange[self._arm_indices().actuators]
 
     def set_arm_control(self, action) -> None:
         """Write tendon contractions to the arm's actuators only (a robot may have others)."""
-        self.data.ctrl[self._arm_indices().actuators] = action
+        self._raw_data.ctrl[self._arm_indices().actuators] = action
 
     def step(self, nstep: int = 1) -> None:
         """Step, but turn a divergence into a flag the task ends the episode on.
@@ -260,7 +278,9 @@ class ArmPhysicsMixin:
         except control.PhysicsError as error:
             self.divergence = str(error)
         else:
-            if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
+            data = self._raw_data
+            # A sum is non-finite exactly when an entry is (our states are far below overflow).
+            if not (math.isfinite(data.qpos.sum()) and math.isfinite(data.qvel.sum())):
                 self.divergence = "non-finite joint state"
         finally:
             _MUJOCO_WARNINGS.active = False
@@ -311,31 +331,31 @@ class QuadrupedPhysicsMixin(ArmPhysicsMixin):
     # Arm head.
     def head_attitude(self) -> float:
         """Head attitude (deg) in the trunk's heading plane: 0 up, 90 level, 180 down."""
-        xmat = self.data.xmat[self._arm_indices().head_body]  # head body; row-major: axis z = (2, 5, 8)
+        indices, data = self._arm_indices(), self._raw_data
+        xmat = data.xmat[indices.head_body]  # head body; row-major: axis z = (2, 5, 8)
         hx, hy = self.heading()
-        return float(continuous_attitude_deg(
-            math.degrees(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8])),
-            self.data.qpos[self._arm_indices().qpos]))
+        return _continuous_attitude(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8]),
+                                    data.qpos[indices.qpos])
 
     # Quadruped.
     def trunk_position(self) -> np.ndarray:
         """Trunk centre (x, y, z), world frame."""
-        return self.data.xpos[self._robot()["trunk"]].copy()
+        return self._raw_data.xpos[self._robot()["trunk"]].copy()
 
     def trunk_velocity(self) -> np.ndarray:
         """Trunk linear velocity, world frame (the free joint's linear velocity)."""
-        return self.data.qvel[:3].copy()
+        return self._raw_data.qvel[:3].copy()
 
     def trunk_height(self) -> float:
-        return float(self.data.xpos[self._robot()["trunk"], 2])
+        return float(self._raw_data.xpos[self._robot()["trunk"], 2])
 
     def trunk_uprightness(self) -> float:
         """z component of the trunk's up axis: 1 upright, 0 on its side."""
-        return float(self.data.xmat[self._robot()["trunk"]][8])
+        return float(self._raw_data.xmat[self._robot()["trunk"]][8])
 
     def heading(self) -> np.ndarray:
         """Unit (x, y) of the trunk's forward axis projected on the ground."""
-        xmat = self.data.xmat[self._robot()["trunk"]]
+        xmat = self._raw_data.xmat[self._robot()["trunk"]]
         fx, fy = float(xmat[0]), float(xmat[3])
         norm = math.hypot(fx, fy)
         return (fx / norm, fy / norm) if norm > 1e-9 else (1.0, 0.0)
@@ -345,7 +365,7 @@ class QuadrupedPhysicsMixin(ArmPhysicsMixin):
         hx, hy = self.heading()
         x, y, z = (float(c) for c in point)
         if not velocity:
-            trunk = self.data.xpos[self._robot()["trunk"]]
+            trunk = self._raw_data.xpos[self._robot()["trunk"]]
             x, y = x - trunk[0], y - trunk[1]
         return np.array([hx * x + hy * y, -hy * x + hx * y, z])
 
@@ -357,21 +377,21 @@ class QuadrupedPhysicsMixin(ArmPhysicsMixin):
 
     def arm_base_position(self) -> np.ndarray:
         """World position of the arm's first joint (C18) on the trunk."""
-        return self.data.xpos[self._robot()["arm_base"]].copy()
+        return self._raw_data.xpos[self._robot()["arm_base"]].copy()
 
     def set_leg_targets(self, targets) -> None:
-        self.data.ctrl[self._robot()["leg_actuators"]] = targets
+        self._raw_data.ctrl[self._robot()["leg_actuators"]] = targets
 
     def place_standing(self, trunk_xy=(0.0, 0.0), trunk_height=quad.STANDING_TRUNK_HEIGHT):
         """Put the quadruped in its standing pose, feet on the ground, arm straight, at rest."""
         targets = gait_lib.Standing().joint_targets(0.0, trunk_height + gait_lib.SAG_COMPENSATION["stand"])
         _, foot_z = gait_lib.leg_fk(targets[1], targets[2])
-        self.data.qpos[:] = 0.0
-        self.data.qpos[:3] = [trunk_xy[0], trunk_xy[1], -foot_z + quad.FOOT_RADIUS]
-        self.data.qpos[3:7] = [1, 0, 0, 0]
-        self.data.qpos[self._robot()["leg_qpos"]] = targets
-        self.data.qvel[:] = 0.0
-        if self.data.act.size:
-            self.data.act[:] = 0.0
+        self._raw_data.qpos[:] = 0.0
+        self._raw_data.qpos[:3] = [trunk_xy[0], trunk_xy[1], -foot_z + quad.FOOT_RADIUS]
+        self._raw_data.qpos[3:7] = [1, 0, 0, 0]
+        self._raw_data.qpos[self._robot()["leg_qpos"]] = targets
+        self._raw_data.qvel[:] = 0.0
+        if self._raw_data.act.size:
+            self._raw_data.act[:] = 0.0
         self.set_leg_targets(targets)
         self.set_arm_control(0.0)

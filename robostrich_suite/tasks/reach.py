@@ -72,11 +72,13 @@ def check_action(action: np.ndarray, control_range: np.ndarray) -> np.ndarray:
     """Reject actions of the wrong shape or type and NaN/inf; clip the rest into
     ``control_range`` ((n, 2) low/high)."""
     action = validate_action(action, len(control_range))
-    if not np.all(np.isfinite(action)):
-        bad = np.flatnonzero(~np.isfinite(action)).tolist()
+    finite = np.isfinite(action)
+    if not finite.all():
+        bad = np.flatnonzero(~finite).tolist()
         raise ValueError(f"action has non-finite values at indices {bad}: {action}")
-    low, high = np.asarray(control_range).T
-    return np.clip(action, low, high)
+    control_range = np.asarray(control_range)
+    # np.clip's result, without its per-call overhead (this runs every control step)
+    return np.minimum(np.maximum(action, control_range[:, 0]), control_range[:, 1])
 
 
 class Reach(base.Task):
@@ -124,6 +126,7 @@ class Reach(base.Task):
         self.desired_attitude = float(desired_attitude)
         self.weights = weights or rewards.RewardWeights()
         self.target_axes = tuple(target_axes)
+        self._target_axes_index = list(self.target_axes)
         if isinstance(randomization, dict):
             randomization = randomization_lib.DomainRandomization(**randomization)
         self.randomizer = (randomization_lib.Randomizer(randomization)
@@ -167,7 +170,7 @@ class Reach(base.Task):
         # Remember where the arm is for the next episode of a "continue" lesson.
         if physics.divergence is None:
             self._last_state = (physics.data.qpos.copy(), physics.data.qvel.copy(),
-                                physics.data.act.copy(), physics.arm_control().copy())
+                                physics.data.act.copy(), physics.arm_control())
         else:
             self._last_state = None
 
@@ -178,7 +181,7 @@ class Reach(base.Task):
 
     # --- measurements ------------------------------------------------------
     def head_xz(self, physics) -> np.ndarray:
-        return physics.head_position()[list(self.target_axes)]
+        return physics.head_position()[self._target_axes_index]
 
     def position_error(self, physics) -> float:
         return float(np.linalg.norm(self.target_position - self.head_xz(physics)))
@@ -220,7 +223,7 @@ class Reach(base.Task):
         obs = collections.OrderedDict()
         head = self.head_xz(physics)
         obs["head_position"] = head
-        obs["head_velocity"] = physics.head_velocity()[list(self.target_axes)]
+        obs["head_velocity"] = physics.head_velocity()[self._target_axes_index]
         joint_angles = physics.joint_angles()
         if self.randomizer is not None:
             joint_angles = self.randomizer.observe_joint_angles(joint_angles, self.random)

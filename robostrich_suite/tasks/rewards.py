@@ -41,6 +41,8 @@ class RewardWeights:
 
     def precision_penalty(self, position_error):
         """The Gaussian precision term (0 at the target, ``position_precision`` far away)."""
+        if not self.position_precision:
+            return 0.0 * np.asarray(position_error, np.float64)
         position_error = np.asarray(position_error, np.float64)
         return self.position_precision * (
             1.0 - np.exp(-0.5 * (position_error / self.precision_scale) ** 2))
@@ -59,7 +61,9 @@ def lesson2_reward(position_error: float, attitude_error_deg: float, position_to
     r_m2 = (-weights.position_miss * float(position_error > position_tolerance)
             - weights.attitude_miss * float(attitude_error_deg > attitude_tolerance_deg))
     r_a2 = -weights.position_error * position_error - weights.attitude_error * attitude_error_deg
-    return r_m2 + r_a2 - float(weights.precision_penalty(position_error))
+    if weights.position_precision:
+        r_a2 -= float(weights.precision_penalty(position_error))
+    return r_m2 + r_a2
 
 
 def lesson1_rewards(position_error, position_tolerance: float) -> np.ndarray:
