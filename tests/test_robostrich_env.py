@@ -128,6 +128,12 @@ def test_precision_term_pays_inside_the_tolerance():
     assert with_term[1] - with_term[2] > 0.5 > eq10[1] - eq10[2]
     np.testing.assert_allclose(rewards.lesson2_rewards(errors, np.ones(4), 0.05, 5.0, precise),
                                with_term)
+    level = rewards.RewardWeights(attitude_precision=1.0, attitude_precision_scale=1.0)
+    assert (rewards.lesson2_reward(0.01, 0.0, 0.05, 5.0, level)
+            - rewards.lesson2_reward(0.01, 2.0, 0.05, 5.0, level)) == pytest.approx(
+        0.02 * 2.0 + 1 - np.exp(-2.0))
+    np.testing.assert_allclose(rewards.lesson2_rewards([0.01, 0.01], [0.0, -2.0], 0.05, 5.0, level),
+                               [rewards.lesson2_reward(0.01, a, 0.05, 5.0, level) for a in (0.0, -2.0)])
     with pytest.raises(ValueError, match="precision_scale"):
         rewards.RewardWeights(precision_scale=0.0)
     with pytest.raises(ValueError, match="position_precision"):

@@ -240,9 +240,7 @@ class Reach(base.Task):
 
     def get_reward(self, physics):
         if physics.divergence is not None:
-            return -2.0 if self.reward_name == "lesson1" else -2.0 * (
-                self.weights.position_miss + self.weights.attitude_miss
-                + self.weights.position_precision)
+            return -2.0 if self.reward_name == "lesson1" else -2.0 * self.weights.largest_penalty
         error = self.position_error(physics)
         if self.reward_name == "lesson1":
             return rewards.lesson1_reward(error, self.position_tolerance)

@@ -19,10 +19,11 @@ class RewardWeights:
     ``attitude_error`` (per degree) weigh the shaping terms.  The defaults make
     a 0.1 m miss and a 10 deg miss cost about the same.
 
-    ``position_precision`` is not in the paper (0 recovers eq. 10): it weighs a
-    Gaussian term ``1 - exp(-e^2 / (2 s^2))`` with ``s = precision_scale`` (m),
-    which keeps paying for precision inside the tolerance, where eq. 10 pays
-    only its 2 per metre shaping.
+    ``position_precision`` and ``attitude_precision`` are not in the paper (0, the
+    default, recovers eq. 10): each weighs a Gaussian term ``1 - exp(-e^2 / (2 s^2))``
+    of the position error (``s = precision_scale``, m) or the attitude error
+    (``s = attitude_precision_scale``, deg), which keeps paying for precision inside
+    the tolerance, where eq. 10 pays only its shaping (2 per metre, 0.02 per degree).
     """
     position_miss: float = 1.0
     attitude_miss: float = 1.0
@@ -30,22 +31,36 @@ class RewardWeights:
     attitude_error: float = 0.02
     position_precision: float = 0.0
     precision_scale: float = 0.01
+    attitude_precision: float = 0.0
+    attitude_precision_scale: float = 1.0
 
     def __post_init__(self):
         for field in dataclasses.fields(self):
             value = getattr(self, field.name)
             if not (np.isfinite(value) and value >= 0):
                 raise ValueError(f"reward weight {field.name} must be a finite number >= 0, got {value}")
-        if self.precision_scale <= 0:
-            raise ValueError(f"precision_scale must be > 0 m, got {self.precision_scale}")
+        for name in ("precision_scale", "attitude_precision_scale"):
+            if getattr(self, name) <= 0:
+                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
 
-    def precision_penalty(self, position_error):
-        """The Gaussian precision term (0 at the target, ``position_precision`` far away)."""
-        if not self.position_precision:
-            return 0.0 * np.asarray(position_error, np.float64)
+    @property
+    def has_precision_terms(self) -> bool:
+        return bool(self.position_precision or self.attitude_precision)
+
+    def precision_penalty(self, position_error, attitude_error_deg=0.0):
+        """The Gaussian precision terms: 0 on target and level, ``position_precision +
+        attitude_precision`` far off."""
         position_error = np.asarray(position_error, np.float64)
-        return self.position_precision * (
-            1.0 - np.exp(-0.5 * (position_error / self.precision_scale) ** 2))
+        attitude_error_deg = np.asarray(attitude_error_deg, np.float64)
+        return (self.position_precision
+                * (1.0 - np.exp(-0.5 * (position_error / self.precision_scale) ** 2))
+                + self.attitude_precision
+                * (1.0 - np.exp(-0.5 * (attitude_error_deg / self.attitude_precision_scale) ** 2)))
+
+    @property
+    def largest_penalty(self) -> float:
+        """The most a step can lose when both are missed far off (a diverged step costs twice this)."""
+        return self.position_miss + self.attitude_miss + self.position_precision + self.attitude_precision
 
 
 def lesson1_reward(position_error: float, position_tolerance: float) -> float:
@@ -61,8 +76,8 @@ def lesson2_reward(position_error: float, attitude_error_deg: float, position_to
     r_m2 = (-weights.position_miss * float(position_error > position_tolerance)
             - weights.attitude_miss * float(attitude_error_deg > attitude_tolerance_deg))
     r_a2 = -weights.position_error * position_error - weights.attitude_error * attitude_error_deg
-    if weights.position_precision:
-        r_a2 -= float(weights.precision_penalty(position_error))
+    if weights.has_precision_terms:
+        r_a2 -= float(weights.precision_penalty(position_error, attitude_error_deg))
     return r_m2 + r_a2
 
 
@@ -80,4 +95,4 @@ def lesson2_rewards(position_error, attitude_error_deg, position_tolerance: floa
     return (-weights.position_miss * (position_error > position_tolerance)
             - weights.attitude_miss * (attitude_error_deg > attitude_tolerance_deg)
             - weights.position_error * position_error - weights.attitude_error * attitude_error_deg
-            - weights.precision_penalty(position_error))
+            - weights.precision_penalty(position_error, attitude_error_deg))
