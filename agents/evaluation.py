@@ -19,7 +19,7 @@ import numpy as np
 
 from agents import probes
 from agents.curriculum import make_environment
-from agents.domains import as_domain
+from agents.domains import MOVING_START_TASK, as_domain
 
 
 def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dict:
@@ -124,8 +124,8 @@ def evaluate_heldout(actor, flattener, domain, task: str, num_targets: Optional[
     for i in range(count):
         if targets is None:
             env = make_environment(domain, task, seed + i)
-        elif env is not None and hasattr(env.task, "target_pool"):
-            env.task.target_pool = targets[i:i + 1]  # reuse the compiled model (building one takes ~0.3 s)
+        elif env is not None:
+            env.task.set_target_pool(targets[i])  # reuse the compiled model (building one takes ~0.3 s)
         else:
             env = make_environment(domain, task, seed, target_pool=targets[i:i + 1])
         row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat))
@@ -152,21 +152,23 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
     """
     targets = heldout_targets(domain, num_targets) if targets is None else np.asarray(targets, np.float64)
     start_positions, start_controls = moving_starts(domain=domain) if starts is None else starts
-    env = make_environment(domain, "lesson3", seed, target_pool=targets[:1])
+    env = make_environment(domain, MOVING_START_TASK, seed, target_pool=targets[:1])
     episodes = []
     for k, (start, control) in enumerate(zip(start_positions, start_controls)):
         for target in targets:
-            env.task.initial_state, env.task.target_pool = "fixed", np.asarray(start, np.float64)[None]
+            env.task.set_initial_state("fixed")
+            env.task.set_target_pool(start)
             timestep = env.reset()
             while not timestep.last():
                 timestep = env.step(control)
             start_error = probes.head_errors(env)
-            env.task.initial_state, env.task.target_pool = "continue", np.asarray(target, np.float64)[None]
+            env.task.set_initial_state("continue")
+            env.task.set_target_pool(target)
             row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat))
             row.update(target=np.asarray(target).tolist(), start=k, start_target=np.asarray(start).tolist(),
                        start_position_error=start_error[0], start_attitude_error=start_error[1])
             episodes.append(row)
-    return {"kind": "heldout_moving", **_names(domain), "task": "lesson3", "summary": summarize(episodes),
+    return {"kind": "heldout_moving", **_names(domain), "task": MOVING_START_TASK, "summary": summarize(episodes),
             "episodes": episodes}
 
 

@@ -150,6 +150,17 @@ class Reach(base.Task):
         self.target_position = self.next_target()
         super().initialize_episode(physics)
 
+    def set_target_pool(self, targets) -> None:
+        """Draw the next episodes' targets from ``targets`` ((n, 2) or one (2,) position):
+        an evaluation reuses one compiled environment for many targets this way."""
+        self.target_pool = as_targets(targets, "target_pool")
+
+    def set_initial_state(self, initial_state: str) -> None:
+        """``"fixed"`` or ``"continue"`` from the next episode on (see the module doc)."""
+        if initial_state not in INITIAL_STATES:
+            raise ValueError(f"unknown initial_state {initial_state!r}; use one of {INITIAL_STATES}")
+        self.initial_state = initial_state
+
     def forget_last_state(self) -> None:
         """The next "continue" episode starts from the fixed pose (as after a divergence)."""
         self._last_state = None
