@@ -37,11 +37,25 @@ def test_head_stays_within_the_sum_of_link_lengths(kinematic, physics):
     assert distance.min() < 0.25 and distance.max() > 0.6
 
 
-def test_joint_angles_are_within_table1_limits(kinematic):
+def _neighbour_correlation(fractions):
+    """Mean correlation of neighbouring joints' positions within their ranges."""
+    return np.mean([np.corrcoef(fractions[:, j], fractions[:, j + 1])[0, 1]
+                    for j in range(fractions.shape[1] - 1)])
+
+
+def test_sampler_fills_each_joint_range_and_edge_samples_bend_neighbours_alike(kinematic):
+    """Uniform samples spread over each joint's whole range and none sits on a limit (a sampler
+    drawing past the limits would show as samples piled on them by its final clip); edge samples
+    bend neighbouring joints the same way (measured correlation 0.81; uniform 0.005)."""
     limits = arm.ArmSpec.from_table1().joint_range_rad()
-    assert np.all(kinematic.joint_angles >= limits[:, 0])
-    assert np.all(kinematic.joint_angles <= limits[:, 1])
-    assert kinematic.uniform.sum() == 3000
+    fraction = (kinematic.joint_angles - limits[:, 0]) / (limits[:, 1] - limits[:, 0])
+    uniform, edge = fraction[kinematic.uniform], fraction[~kinematic.uniform]
+    assert len(uniform) == len(edge) == 3000
+    assert np.all((uniform > 0) & (uniform < 1))
+    assert np.all(uniform.min(axis=0) < 0.01) and np.all(uniform.max(axis=0) > 0.99)  # measured 0.0013
+    np.testing.assert_allclose(uniform.mean(axis=0), 0.5, atol=0.03)  # 5.7 standard errors
+    assert abs(_neighbour_correlation(uniform)) < 0.05
+    assert _neighbour_correlation(edge) > 0.6
 
 
 def test_attitude_is_the_sum_of_joint_angles(kinematic):
@@ -51,15 +65,22 @@ def test_attitude_is_the_sum_of_joint_angles(kinematic):
     assert summed.min() < -180 and summed.max() > 180  # the edge samples curl past a half turn
 
 
-def test_blue_set_is_a_level_subset_of_the_red_set(kinematic):
+def test_blue_region_is_where_mujoco_points_the_head_forward_within_5_degrees(kinematic, physics):
+    """The blue mask (attitude 90 +- 5 deg) against what it stands for: posed in MuJoCo, exactly
+    the blue samples have the head's long axis within 5 deg of +x (level, facing forward).  Among
+    them are necks curled back by about -270 deg (measured 32 of 96), which count because the
+    attitude error is taken modulo a turn."""
+    indices = physics_lib.arm_indices(physics.model)
+    forward = np.empty(len(kinematic.joint_angles))
+    for i, angles in enumerate(kinematic.joint_angles):
+        physics.data.qpos[indices.qpos] = angles
+        physics.forward()
+        forward[i] = physics.data.xmat[indices.head_body].reshape(3, 3)[0, 2]  # head axis, world x
     level = kinematic.level()
+    np.testing.assert_array_equal(level, forward >= np.cos(np.radians(5)))
     assert 0 < level.sum() < len(level)
-    blue = kinematic.head_position[level]
-    red = {tuple(p) for p in kinematic.head_position}
-    assert all(tuple(p) in red for p in blue)
-    error = np.abs(physics_lib.attitude_error_deg(kinematic.head_attitude, 90))  # where the head points
-    assert np.all(error[level] <= 5)
-    assert np.all(error[~level] > 5)
+    curled_back = np.degrees(kinematic.joint_angles[level].sum(axis=1)) < -180
+    assert curled_back.sum() >= 10
 
 
 def test_actuated_poses_lie_in_the_kinematic_workspace(actuated, physics):
@@ -78,7 +99,7 @@ def test_actuated_poses_lie_in_the_kinematic_workspace(actuated, physics):
     for pose, head in zip(clamped, actuated.head_position[actuated.settled]):
         with physics.reset_context():
             physics.data.qpos[qpos_adr] = pose
-        assert np.linalg.norm(workspace.head_position_xz(physics) - head) < 0.01
+        assert np.linalg.norm(physics.head_position()[[0, 2]] - head) < 0.01
     base = workspace.base_joint_xz(physics)
     distance = np.linalg.norm(actuated.head_position - base, axis=1)
     assert distance.max() <= workspace.reach_radius() + 1e-9
@@ -96,8 +117,27 @@ def test_level_seeking_finds_inputs_that_hold_the_head_level(physics):
     assert level.sum() >= 2  # measured 42 % of draws (3.5 % without seeking)
     for control, head in zip(samples.control[level], samples.head_position[level]):
         assert workspace.settle(physics, control)  # the stored inputs alone, from reset
-        np.testing.assert_allclose(workspace.head_position_xz(physics), head, atol=1e-9)
-        assert abs(physics_lib.attitude_error_deg(workspace.head_attitude_deg(physics), 90)) <= 5
+        np.testing.assert_allclose(physics.head_position()[[0, 2]], head, atol=1e-9)
+        assert abs(physics_lib.attitude_error_deg(physics.head_attitude(), 90)) <= 5
+
+
+def test_frame_physics_reads_the_arm_and_a_diverged_pose_never_counts_as_settled(caplog):
+    """frame_physics gives the studies the tasks' accessors; an arm that blows up (joints 10^6
+    times stiffer) is a pose that did not come to rest: neither a crash nor the resting straight
+    neck that MuJoCo resets a diverged simulation to."""
+    physics = scenes.frame_physics()
+    with physics.reset_context():
+        physics.data.qpos[physics_lib.arm_indices(physics.model).qpos] = np.radians(5.0)
+    assert physics.head_attitude() == pytest.approx(18 * 5.0, abs=1e-9)
+    np.testing.assert_allclose(physics.joint_angles(), np.radians(5.0))
+    stiff = scenes.frame_physics(arm.ArmSpec.from_table1(joint_stiffness=1e6))
+    top = stiff.model.actuator_ctrlrange[:, 1]
+    # 5 steps: MuJoCo resets the blown-up state to the straight neck, which is still at rest
+    assert not workspace.settle(stiff, top, settle_time=0.01)
+    assert np.abs(stiff.data.qvel).max() < 0.05 and np.abs(stiff.joint_angles()).max() < 0.01
+    assert stiff.divergence is not None and "diverged" in caplog.text
+    assert workspace.settle(physics, np.zeros(physics.model.nu), settle_time=1.5)  # the default arm rests
+    assert physics.divergence is None
 
 
 def test_command_line_writes_the_figure_and_the_samples(tmp_path):
@@ -114,12 +154,19 @@ def test_command_line_writes_the_figure_and_the_samples(tmp_path):
         assert str(data["fingerprint"]) == fingerprint_lib.model_fingerprint()
 
 
-def test_targets_are_generated_from_the_workspace_sampler(tmp_path):
-    """target_generation.generate still draws from workspace.actuated_samples (the one source)."""
+def test_targets_are_generated_from_the_workspace_sampler(tmp_path, physics):
+    """target_generation.generate writes exactly the level subset of workspace.actuated_samples
+    (the one source of targets), with the inputs that hold each pose."""
     path = tmp_path / "poses.npz"
     count = target_generation.generate(4, seed=5, path=path, workers=1)
+    samples = workspace.actuated_samples(4, seed=5, physics=physics,
+                                         seek_level_time=target_generation.SEEK_LEVEL_TIME)
+    level = samples.level()
+    assert count == level.sum() > 0
     with np.load(path) as data:
-        assert len(data["head_position"]) == count
+        np.testing.assert_array_equal(data["head_position"], samples.head_position[level])
+        np.testing.assert_array_equal(data["head_attitude"], samples.head_attitude[level])
+        np.testing.assert_array_equal(data["control"], samples.control[level])
         assert np.all(np.abs(physics_lib.attitude_error_deg(data["head_attitude"], 90)) <= 5)
 
 

@@ -1,7 +1,9 @@
 """The scenes the arm is simulated in: the immobile frame and the A1 composition.
 
 * the frame arena (:func:`build_frame_arm`): the paper's first setup, the arm's base on
-  an immobile post, neck pointing up; :func:`frame_physics` compiles it for the studies;
+  an immobile post, neck pointing up; :func:`frame_physics` compiles it for the studies
+  into a :class:`FramePhysics`, which reads it through the one accessor layer
+  (:class:`robostrich_suite.physics.ArmPhysicsMixin`);
 * the A1 composition (:func:`build_a1`): the quadruped with the arm on its trunk, on a
   floor, optionally in front of the narrow-gap wall of Fig. 10 (``scene="narrow_gap"``).
 """
@@ -55,9 +57,17 @@ def build_frame_arm(spec: arm_lib.ArmSpec | None = None, layout: arm_lib.TendonL
     return arena
 
 
-def frame_physics(spec=None, layout=None) -> mjcf.Physics:
-    """The arm on its frame, compiled (plain ``mjcf.Physics``; read it with :mod:`physics`)."""
-    return mjcf.Physics.from_mjcf_model(build_frame_arm(spec, layout))
+class FramePhysics(physics_lib.ArmPhysicsMixin, mujoco.Physics):
+    """The arm on its frame with the arm's accessors (head, joints, tendons) and
+    divergence capture: a step that diverges sets ``divergence`` instead of raising,
+    and steps are no-ops until the next ``reset``."""
+
+
+def frame_physics(spec=None, layout=None) -> FramePhysics:
+    """The arm on its frame, compiled at full XML precision (as ``mjcf.Physics.from_mjcf_model``
+    does; the ``robostrich`` domain rounds its XML to 10 digits)."""
+    model = build_frame_arm(spec, layout)
+    return FramePhysics.from_xml_string(model.to_xml_string(), model.get_assets())
 
 
 # --- the A1 composition ------------------------------------------------------------------

@@ -17,12 +17,11 @@ import pathlib
 import time
 
 import numpy as np
-from dm_control import mjcf
+from dm_control.rl import control as control_lib
 
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite.model import scenes
-from robostrich_suite.studies import workspace
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
 
 PATTERNS = ("rolling", "lever")
@@ -90,7 +89,7 @@ def hold_dorsal_length(dorsal_input: float, target: float, contraction: float, d
                          *control_range))
 
 
-def ventral_amplitudes(config: MovementConfig, physics: mjcf.Physics) -> np.ndarray:
+def ventral_amplitudes(config: MovementConfig, physics: scenes.FramePhysics) -> np.ndarray:
     """The contraction (m) each ventral tendon is ramped to: the configured amplitude,
     clipped to that tendon's input range (so most get less than asked)."""
     low, high = physics.model.actuator_ctrlrange.T
@@ -98,7 +97,7 @@ def ventral_amplitudes(config: MovementConfig, physics: mjcf.Physics) -> np.ndar
     return np.clip(config.ventral_amplitude(), low[ventral], high[ventral])
 
 
-def schedule(config: MovementConfig, physics: mjcf.Physics):
+def schedule(config: MovementConfig, physics: scenes.FramePhysics):
     """``f(t) -> contraction targets`` for every tendon (dorsal: the held contraction).
 
     Both patterns start from the same pose (dorsal at ``dorsal``, the most caudal
@@ -179,7 +178,7 @@ class Movement:
                 "attitude_end_deg": round(float(self.head_attitude[-1]), 2)}
 
 
-def _chain_points(physics: mjcf.Physics, spec: arm_lib.ArmSpec) -> np.ndarray:
+def _chain_points(physics: scenes.FramePhysics, spec: arm_lib.ArmSpec) -> np.ndarray:
     """Joint positions from the base (C18) joint to the atlas, then the head tip, as (x, z)."""
     names = [f"{arm_lib.ARM_MODEL_NAME}/{n}" for n in reversed(spec.joint_names)]
     points = [physics.named.data.xpos[n][[0, 2]] for n in names]
@@ -190,7 +189,7 @@ def _chain_points(physics: mjcf.Physics, spec: arm_lib.ArmSpec) -> np.ndarray:
 
 
 def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
-        physics: mjcf.Physics | None = None, recording=None, progress: bool = False
+        physics: scenes.FramePhysics | None = None, recording=None, progress: bool = False
         ) -> Movement:
     """Simulate one movement test; log it to ``recording`` (a Rerun stream) if given."""
     spec = spec or arm_lib.ArmSpec.from_table1()
@@ -199,8 +198,6 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
     config.validate(len(ventral))
     dorsal = physics_lib.dorsal_index(physics.model)
     model = physics.model
-    indices = physics_lib.arm_indices(model)
-    tendon_ids, rest = indices.tendons, indices.rest_lengths
     targets = schedule(config, physics)
     dt = model.opt.timestep
     steps = int(round(config.duration(len(ventral)) / dt))
@@ -227,20 +224,23 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
             if k % RECORD_EVERY == 0:  # a new draw each control step (0.008 s)
                 noise[ventral] = config.input_noise * rng.standard_normal(len(ventral))
             x = np.clip(x + noise, *model.actuator_ctrlrange.T)
-        contraction = rest - physics.data.ten_length[tendon_ids]
+        contraction = physics.tendon_contractions()
         if config.dorsal_hold == "length":
             dorsal_input = hold_dorsal_length(dorsal_input, x[dorsal], contraction[dorsal], dt,
                                               model.actuator_ctrlrange[dorsal])
             x[dorsal] = dorsal_input
         physics.data.ctrl[:] = x
         if k % RECORD_EVERY == 0:
-            head = workspace.head_position_xz(physics)
-            attitude = workspace.head_attitude_deg(physics)
+            head = physics.head_position()[[0, 2]]
+            attitude = physics.head_attitude()
             rows.append((t, x.copy(), contraction, head, attitude, _chain_points(physics, spec)))
             if recording is not None:
                 _log_frame(recording, physics, rows, names, sides)
         if k < steps:
             physics.step()
+            if physics.divergence is not None:
+                raise control_lib.PhysicsError(f"{config.pattern} test diverged at t = {t:.3f} s: "
+                                               f"{physics.divergence}")
     time_, control, contraction, head, attitude, points = (np.array(c) for c in zip(*rows))
     return Movement(config, names, sides, time_, control, contraction, head, attitude, points,
                     ventral_amplitudes(config, physics))
@@ -331,8 +331,6 @@ def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int
     physics = scenes.frame_physics(spec, layout)
     model = physics.model
     ventral, dorsal_id = physics_lib.ventral_indices(physics.model), physics_lib.dorsal_index(physics.model)
-    indices = physics_lib.arm_indices(model)
-    tendon_ids, rest = indices.tendons, indices.rest_lengths
     high = model.actuator_ctrlrange[ventral, 1]
     rng = np.random.default_rng(seed)
     inputs = rng.uniform(size=(num_poses, len(ventral))) ** 2 * high
@@ -350,15 +348,15 @@ def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int
         dorsal_input = 0.0
         for k in range(int(round(settle_time / dt))):
             ramp = min(k * dt / RAMP_IN_TIME, 1.0)
-            contraction = rest[dorsal_id] - physics.data.ten_length[tendon_ids[dorsal_id]]
+            contraction = physics.tendon_contractions()[dorsal_id]
             dorsal_input = hold_dorsal_length(dorsal_input, ramp * dorsal, contraction, dt,
                                               model.actuator_ctrlrange[dorsal_id])
             physics.data.ctrl[dorsal_id] = dorsal_input
             physics.data.ctrl[ventral] = ramp * inputs[i]
             physics.step()
-        settled[i] = np.abs(physics.data.qvel).max() < 0.05
-        positions[i] = workspace.head_position_xz(physics)
-        attitudes[i] = workspace.head_attitude_deg(physics)
+        settled[i] = physics.divergence is None and np.abs(physics.data.qvel).max() < 0.05
+        positions[i] = physics.head_position()[[0, 2]]
+        attitudes[i] = physics.head_attitude()
     return PoseFamily(dorsal, inputs, positions, attitudes, settled)
 
 

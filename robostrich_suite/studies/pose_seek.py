@@ -36,14 +36,11 @@ HOLD_TIME = LESSON_TIME_LIMIT  # s a candidate is held from the fixed start: one
 
 def contraction_at(physics, joint_angles: np.ndarray, spec: arm_lib.ArmSpec) -> np.ndarray:
     """Every tendon's contraction (servo rest length minus length) in the pose ``joint_angles``."""
-    model = physics.model
-    indices = physics_lib.arm_indices(model)
-    qpos_adr = indices.qpos
     with physics.reset_context():
-        physics.data.qpos[qpos_adr] = joint_angles
-    lengths = np.array(physics.data.ten_length[indices.tendons])
+        physics.data.qpos[physics_lib.arm_indices(physics.model).qpos] = joint_angles
+    contraction = physics.tendon_contractions()
     physics.reset()
-    return indices.rest_lengths - lengths
+    return contraction
 
 
 def seek_pose(physics, target_xz, control, seek_time: float = SEEK_TIME,
@@ -97,9 +94,9 @@ def seek_samples(targets_xz, joint_angles, spec: arm_lib.ArmSpec | None = None,
         control = seek_pose(physics, target, start, seek_time)
         result.control[i] = control
         result.settled[i] = workspace.settle(physics, control, hold_time)
-        result.head_position[i] = workspace.head_position_xz(physics)
-        result.head_attitude[i] = workspace.head_attitude_deg(physics)
-        result.joint_angles[i] = workspace.arm_joint_angles(physics)
+        result.head_position[i] = physics.head_position()[[0, 2]]
+        result.head_attitude[i] = physics.head_attitude()
+        result.joint_angles[i] = physics.joint_angles()
         if progress is not None:
             progress(1)
     return result

@@ -21,7 +21,6 @@ import time
 
 import mujoco
 import numpy as np
-from dm_control import mjcf
 
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import physics as physics_lib
@@ -34,21 +33,7 @@ from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERAN
 LIMIT_TOLERANCE_DEG = 1.0
 
 
-def head_position_xz(physics: mjcf.Physics) -> np.ndarray:
-    return physics_lib.head_position(physics)[[0, 2]]
-
-
-def head_attitude_deg(physics: mjcf.Physics) -> float:
-    """Angle of the head axis from the vertical in the x-z plane: 90 = level."""
-    return physics_lib.head_attitude_deg(physics)
-
-
-def arm_joint_angles(physics: mjcf.Physics) -> np.ndarray:
-    """The arm's joint angles (rad) in Table 1 order (atlas first)."""
-    return np.array(physics.data.qpos[physics_lib.arm_indices(physics.model).qpos])
-
-
-def base_joint_xz(physics: mjcf.Physics, spec: arm_lib.ArmSpec | None = None) -> np.ndarray:
+def base_joint_xz(physics: scenes.FramePhysics, spec: arm_lib.ArmSpec | None = None) -> np.ndarray:
     """World (x, z) of the joint between the base link (C18) and the frame (Fig. 6's black dot)."""
     spec = spec or arm_lib.ArmSpec.from_table1()
     return np.array(physics.named.data.xpos[f"{arm_lib.ARM_MODEL_NAME}/{spec.base_link}"])[[0, 2]]
@@ -105,7 +90,7 @@ def sample_joint_angles(num_uniform: int, num_edge: int, rng: np.random.Generato
 
 
 def kinematic_samples(num_samples: int, seed: int = 0, spec: arm_lib.ArmSpec | None = None,
-                      physics: mjcf.Physics | None = None, progress: bool = False,
+                      physics: scenes.FramePhysics | None = None, progress: bool = False,
                       num_edge: int = 0) -> KinematicSamples:
     """``num_samples`` uniform joint angles within Table 1's limits (plus ``num_edge`` edge
     samples, see :func:`sample_joint_angles`); head pose by MuJoCo forward kinematics."""
@@ -155,21 +140,21 @@ class ActuatedSamples:
                      else np.concatenate([getattr(p, f) for p in parts]) for f in fields))
 
 
-def settle(physics: mjcf.Physics, control: np.ndarray, settle_time: float = 1.5,
+def settle(physics: scenes.FramePhysics, control: np.ndarray, settle_time: float = 1.5,
            speed_tolerance: float = 0.05) -> bool:
-    """Reset, hold ``control`` for ``settle_time`` seconds; True if the arm came to rest."""
+    """Reset, hold ``control`` for ``settle_time`` seconds; True if the arm came to rest.
+    A simulation that diverged never did, even where MuJoCo's reset left it still."""
     physics.reset()
     physics.data.ctrl[:] = control
     steps = int(round(settle_time / physics.model.opt.timestep))
     physics.step(steps)
-    return bool(np.all(np.isfinite(physics.data.qpos))
-                and np.abs(physics.data.qvel).max() < speed_tolerance)
+    return bool(physics.divergence is None and np.abs(physics.data.qvel).max() < speed_tolerance)
 
 
 LEVEL_SEEK_GAIN = 1e-3  # m of dorsal input per degree of attitude error per second
 
 
-def seek_level(physics: mjcf.Physics, control: np.ndarray, seek_time: float) -> np.ndarray:
+def seek_level(physics: scenes.FramePhysics, control: np.ndarray, seek_time: float) -> np.ndarray:
     """From reset, hold ``control`` but servo the dorsal input (:func:`physics_lib.dorsal_index`) on
     the head attitude towards 90 deg for ``seek_time`` seconds; return the inputs with the
     final dorsal input.
@@ -183,7 +168,7 @@ def seek_level(physics: mjcf.Physics, control: np.ndarray, seek_time: float) -> 
     physics.reset()
     physics.data.ctrl[:] = control
     for _ in range(int(round(seek_time / dt))):
-        error = float(physics_lib.attitude_error_deg(head_attitude_deg(physics), LEVEL_ATTITUDE_DEG))
+        error = float(physics_lib.attitude_error_deg(physics.head_attitude(), LEVEL_ATTITUDE_DEG))
         control[dorsal] = np.clip(control[dorsal] + LEVEL_SEEK_GAIN * error * dt, low, high)
         physics.data.ctrl[dorsal] = control[dorsal]
         physics.step()
@@ -191,7 +176,7 @@ def seek_level(physics: mjcf.Physics, control: np.ndarray, seek_time: float) -> 
 
 
 def actuated_samples(num_samples: int, seed: int = 0, settle_time: float = 1.5,
-                     physics: mjcf.Physics | None = None, progress: bool = False,
+                     physics: scenes.FramePhysics | None = None, progress: bool = False,
                      seek_level_time: float = 0.0, spec: arm_lib.ArmSpec | None = None,
                      layout: arm_lib.TendonLayout | None = None) -> ActuatedSamples:
     """Hold uniformly random tendon inputs and record the settled head poses.
@@ -217,9 +202,9 @@ def actuated_samples(num_samples: int, seed: int = 0, settle_time: float = 1.5,
         if seek_level_time > 0:
             controls[i] = seek_level(physics, controls[i], seek_level_time)
         settled[i] = settle(physics, controls[i], settle_time)
-        positions[i] = head_position_xz(physics)
-        attitudes[i] = head_attitude_deg(physics)
-        angles[i] = arm_joint_angles(physics)
+        positions[i] = physics.head_position()[[0, 2]]
+        attitudes[i] = physics.head_attitude()
+        angles[i] = physics.joint_angles()
     return ActuatedSamples(positions, attitudes, controls, settled, angles)
 
 
