@@ -9,7 +9,7 @@ import json
 import os
 import pickle
 import zlib
-from typing import Callable, List, Optional, Sequence
+from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -70,6 +70,12 @@ class TrainingInterrupted(RuntimeError):
     """Raised by `stop_at_step` to imitate a killed process in tests."""
 
 
+def run_files(run_dir: str) -> Tuple[str, str, str]:
+    """A run directory's checkpoint, per-episode metrics and periodic evaluations."""
+    return (os.path.join(run_dir, "checkpoint.pkl"), os.path.join(run_dir, "metrics.jsonl"),
+            os.path.join(run_dir, "evals.jsonl"))
+
+
 class CurriculumRun:
     """A learner, its replay and its position in a lesson plan, with checkpoints.
 
@@ -100,9 +106,7 @@ class CurriculumRun:
         base = self.domain(self.plan[0])  # a residual policy adds to this domain's (and layout's) lookup
         self.loop = SACBuilder(config).make_components(self._make_lesson_env(0), seed,
                                                        base.lookup_table() if config.residual_scale > 0 else None)
-        self.checkpoint_path = os.path.join(run_dir, "checkpoint.pkl")
-        self.metrics_path = os.path.join(run_dir, "metrics.jsonl")
-        self.evals_path = os.path.join(run_dir, "evals.jsonl")
+        self.checkpoint_path, self.metrics_path, self.evals_path = run_files(run_dir)
 
     # -- lessons ---------------------------------------------------------------------------
     def _make_lesson_env(self, index):

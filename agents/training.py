@@ -24,7 +24,7 @@ from typing import Optional
 import numpy as np
 
 from agents import evaluation
-from agents.curriculum import CurriculumRun, Lesson, format_plan, parse_plan, run_identity
+from agents.curriculum import CurriculumRun, Lesson, format_plan, parse_plan, run_files, run_identity
 from agents.domains import Domain
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
@@ -222,6 +222,36 @@ class RunJob:
     stop_at_step: Optional[int] = None
 
 
+@dataclasses.dataclass(frozen=True)
+class RunSpec:
+    """Everything a CurriculumRun is built from (picklable): the parent process of a parallel
+    job passes it to a worker instead of building the run (networks, replay, environment)
+    itself, which it would only throw away."""
+
+    label: str
+    plan: tuple
+    config: SACConfig
+    seed: int
+    run_dir: str
+    checkpoint_every: int
+    task_kwargs: Optional[dict]
+    layout: Optional[str]
+
+    @property
+    def total_steps(self) -> int:
+        return sum(l.steps for l in self.plan)
+
+    def build(self, restore: bool) -> CurriculumRun:
+        """The run; restored from its checkpoint when ``restore`` and one exists (raises on a
+        damaged or mismatched checkpoint, never restarts silently)."""
+        run = CurriculumRun(list(self.plan), self.config, self.seed, self.run_dir,
+                            checkpoint_every=self.checkpoint_every, name=self.label,
+                            task_kwargs=self.task_kwargs, layout=self.layout)
+        if restore and os.path.exists(run.checkpoint_path):
+            run.restore()
+        return run
+
+
 def train_and_evaluate(run: CurriculumRun, job: RunJob, progress=None) -> dict:
     """Finish `run`'s plan (periodic held-out evaluations in its evals.jsonl), then its final
     evaluation (JSON reports in job.out_eval). Returns the reports and the run's counters."""
@@ -268,13 +298,12 @@ class _QueueProgress:
         pass
 
 
-def _worker(label, plan, config_dict, seed, run_dir, checkpoint_every, task_kwargs, layout, job, queue):
+def _worker(spec: RunSpec, job, queue):
     """One run in its own process: restore its latest checkpoint (if any), train, evaluate."""
-    run = CurriculumRun(plan, SACConfig.from_dict(config_dict), seed, run_dir,
-                        checkpoint_every=checkpoint_every, name=label, task_kwargs=task_kwargs, layout=layout)
-    if os.path.exists(run.checkpoint_path):
-        run.restore()
+    label = spec.label
     try:
+        run = spec.build(restore=True)
+        queue.put(("steps", label, (run.loop.env_steps, lesson_text(run))))  # where a resumed run starts
         outcome = train_and_evaluate(run, job, _QueueProgress(queue, label))
         queue.put(("done", label, {k: v for k, v in outcome.items() if k != "reports"}))
     except BaseException as error:  # the parent reports it; a traceback here would interleave the bar
@@ -282,7 +311,7 @@ def _worker(label, plan, config_dict, seed, run_dir, checkpoint_every, task_kwar
         raise
 
 
-def _train_in_parallel(runs: dict, job: RunJob, progress, workers: int) -> dict:
+def _train_in_parallel(specs: dict, job: RunJob, progress, workers: int) -> dict:
     """Each run in its own process (one core each): the curriculum and the plain-SAC baseline are
     independent, so on two cores the main job takes the time of one run. Workers restore from and
     write the same checkpoints as a sequential run, so results are identical and resumable."""
@@ -294,16 +323,14 @@ def _train_in_parallel(runs: dict, job: RunJob, progress, workers: int) -> dict:
     saved = os.environ.get("XLA_FLAGS")
     os.environ["XLA_FLAGS"] = ((saved or "") + " --xla_cpu_multi_thread_eigen=false"
                                " intra_op_parallelism_threads=1").strip()
-    pending = [label for label in runs]
+    pending = list(specs)
     active, outcomes, errors = {}, {}, {}
     try:
         while pending or active:
             while pending and len(active) < workers:
                 label = pending.pop(0)
-                run = runs[label]  # a fresh worker builds the same run from the same seed, or restores it
-                process = context.Process(target=_worker, args=(
-                    label, run.plan, run.config.to_dict(), run.seed, run.run_dir, run.checkpoint_every,
-                    run.task_kwargs, run.layout, job, queue))
+                # the worker builds the run from the same seed, or restores it
+                process = context.Process(target=_worker, args=(specs[label], job, queue))
                 process.start()
                 active[label] = process
             try:
@@ -375,18 +402,18 @@ def main(argv=None):
     eval_every = args.eval_every or max(1, total // 6)
     eval_at = sorted(set(boundaries) | set(range(eval_every, total + 1, eval_every)))
 
-    runs = {}
-    for label, run_plan in run_plans.items():
-        run = CurriculumRun(run_plan, config, args.seed, os.path.join(args.out, label),
-                            checkpoint_every=args.checkpoint_every, name=label, task_kwargs=args.task_kwargs,
-                            layout=args.layout)
-        if args.resume and os.path.exists(run.checkpoint_path):
-            run.restore()  # raises on damaged/mismatched checkpoints, never restarts silently
-        runs[label] = run
-    # Every checkpoint is restored: only now change the run directory (a rejected resume leaves it as it was).
-    for run in runs.values():
-        if not (args.resume and os.path.exists(run.checkpoint_path)):
-            for p in (run.metrics_path, run.evals_path):  # a run that died before its first checkpoint
+    specs = {label: RunSpec(label, tuple(run_plan), config, args.seed, os.path.join(args.out, label),
+                            args.checkpoint_every, args.task_kwargs, args.layout)
+             for label, run_plan in run_plans.items()}
+    workers = args.workers if args.stop_at_step is None else 1  # the kill hook raises in this process
+    parallel = workers > 1 and len(specs) > 1
+    # Sequential: build (and restore) every run here; parallel: the workers do, once each.
+    runs = {} if parallel else {label: spec.build(restore=args.resume) for label, spec in specs.items()}
+    # Every checkpoint is checked: only now change the run directory (a rejected resume leaves it as it was).
+    for spec in specs.values():
+        checkpoint_path, metrics_path, evals_path = run_files(spec.run_dir)
+        if not (args.resume and os.path.exists(checkpoint_path)):
+            for p in (metrics_path, evals_path):  # a run that died before its first checkpoint
                 if os.path.exists(p):
                     os.unlink(p)
     evaluation.write_json(os.path.join(args.out, "config.json"), {
@@ -398,12 +425,11 @@ def main(argv=None):
     job = RunJob(domain=domain, heldout_task=heldout_task, track_task=track_task, eval_at=tuple(eval_at),
                  num_eval_targets=args.num_eval_targets, final_eval_targets=args.final_eval_targets,
                  out_eval=out_eval, record=not args.no_rerun, stop_at_step=args.stop_at_step)
-    progress = Progress(sum(r.total_steps for r in runs.values()), enabled=not args.quiet)
+    progress = Progress(sum(spec.total_steps for spec in specs.values()), enabled=not args.quiet)
     progress.bar and progress.bar.update(sum(r.loop.env_steps for r in runs.values()))
-    workers = args.workers if args.stop_at_step is None else 1  # the kill hook raises in this process
     try:
-        if workers > 1 and len(runs) > 1:
-            outcomes = _train_in_parallel(runs, job, progress, workers)
+        if parallel:
+            outcomes = _train_in_parallel(specs, job, progress, workers)
         else:
             outcomes = {label: train_and_evaluate(run, job, progress) for label, run in runs.items()}
     finally:
@@ -413,8 +439,9 @@ def main(argv=None):
                                         record=not args.no_rerun)
     if lookup is not None:  # the no-learning bar, beside the agents
         finals["lookup"] = lookup
-    metrics = {label: read_jsonl(run.metrics_path) for label, run in runs.items()}
-    evals = {label: read_jsonl(run.evals_path) for label, run in runs.items()}  # written by whoever trained
+    # written by whoever trained, here or in a worker
+    metrics = {label: read_jsonl(run_files(spec.run_dir)[1]) for label, spec in specs.items()}
+    evals = {label: read_jsonl(run_files(spec.run_dir)[2]) for label, spec in specs.items()}
     if not args.no_figures:
         from agents import figures
         os.makedirs(os.path.join(args.out, "figures"), exist_ok=True)
