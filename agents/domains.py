@@ -56,6 +56,15 @@ class Domain:
         from dm_control import suite
         return tuple(task for domain, task in suite.ALL_TASKS if domain == self.name)
 
+    def curriculum(self) -> Tuple[str, ...]:
+        """The lessons of Algorithm 1 on this domain, in order (its tasks tagged ``curriculum``):
+        lessons 1-3 on the frame; lessons 1-4 on the quadruped."""
+        if not self.is_arm:
+            raise ValueError(f"{self.name!r} is not a robostrich_suite domain and has no curriculum: "
+                             "give its tasks with --lessons or --plan")
+        import robostrich_suite
+        return tuple(task for domain, task in robostrich_suite.CURRICULUM_TASKS if domain == self.name)
+
     def check_task(self, task: str) -> None:
         """ValueError naming the problem if this domain has no task `task`."""
         tasks = self.tasks()

@@ -30,7 +30,6 @@ from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 
 DEFAULT_TOTAL_STEPS = 240_000  # per run: 80k control steps per lesson; the two runs train side by side
-DEFAULT_LESSONS = ("lesson1", "lesson2", "lesson3")
 
 
 def lesson_text(run) -> str:
@@ -102,7 +101,9 @@ def build_parser():
     p.add_argument("--domain", default="robostrich")
     p.add_argument("--steps", type=int, default=DEFAULT_TOTAL_STEPS,
                    help="total environment steps of the curriculum, split evenly over its lessons")
-    p.add_argument("--lessons", default=",".join(DEFAULT_LESSONS), help="lesson tasks, in order")
+    p.add_argument("--lessons", default=None,
+                   help="lesson tasks, in order (default: the domain's curriculum: lesson1-3 on robostrich, "
+                        "lesson1-4 on robostrich_a1)")
     p.add_argument("--plan", default=None,
                    help="explicit plan '[domain/]task:steps,...' (overrides --steps/--lessons)")
     p.add_argument("--seed", type=int, default=0)
@@ -194,7 +195,10 @@ def _explicit_fields(argv) -> set:
 def plan_from_args(args):
     if args.plan:
         return parse_plan(args.plan, default_domain=args.domain)
-    tasks = [t for t in args.lessons.split(",") if t]
+    if args.lessons is None:
+        tasks = list(Domain(args.domain).curriculum())
+    else:
+        tasks = [t for t in args.lessons.split(",") if t]
     per = args.steps // len(tasks)
     steps = [per] * (len(tasks) - 1) + [args.steps - per * (len(tasks) - 1)]
     return [Lesson(args.domain, t, s) for t, s in zip(tasks, steps)]

@@ -102,3 +102,18 @@ def test_periodic_evaluation_targets_spread_over_the_held_out_set():
     upper = np.percentile(full[:, 1], 67)
     assert (subset[:, 1] > upper).sum() >= 5
     np.testing.assert_array_equal(Domain("robostrich").heldout_targets(100), Domain("robostrich").heldout_targets())
+
+
+def test_default_lessons_are_the_domains_curriculum():
+    """Without --lessons/--plan, robostrich-train runs Algorithm 1 of the chosen domain: lessons 1-3
+    on the frame, 1-4 (lesson 4 trotting) on the quadruped; a dm_control domain must name its tasks."""
+    from agents import training
+    parse = training.build_parser().parse_args
+    frame = training.plan_from_args(parse(["--steps", "300"]))
+    assert [(l.domain, l.task, l.steps) for l in frame] == [
+        ("robostrich", "lesson1", 100), ("robostrich", "lesson2", 100), ("robostrich", "lesson3", 100)]
+    quadruped = training.plan_from_args(parse(["--domain", "robostrich_a1", "--steps", "1000"]))
+    assert [l.task for l in quadruped] == ["lesson1", "lesson2", "lesson3", "lesson4"]
+    assert sum(l.steps for l in quadruped) == 1000
+    with pytest.raises(ValueError, match="has no curriculum"):
+        training.plan_from_args(parse(["--domain", "cartpole"]))
