@@ -41,6 +41,8 @@ setup(
             "robostrich-layouts = robostrich_suite.studies.layout_compare:cli",
             "robostrich-targets = robostrich_suite.studies.target_generation:cli",
             "robostrich-gait = robostrich_suite.studies.gait_generation:cli",
+            "robostrich-stabilize = agents.application_commands:stabilize_cli",
+            "robostrich-gap = agents.application_commands:gap_cli",
         ],
     },
 )

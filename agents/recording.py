@@ -16,6 +16,15 @@ def _to_3d(xz):
     return [float(xz[0]), 0.0, float(xz[1])] if xz.size == 2 else [float(v) for v in xz[:3]]
 
 
+def _target_in_world(env) -> list:
+    """The task's target as a world point: on ``robostrich_a1`` targets are (forward, up) in the
+    trunk frame (robostrich_suite.tasks.quadruped_tasks), on the frame arm world (x, z)."""
+    target = np.asarray(env.task.target_position, np.float64)
+    if hasattr(env.physics, "from_trunk_frame"):
+        return [float(v) for v in env.physics.from_trunk_frame(float(target[0]), float(target[1]))]
+    return _to_3d(target)
+
+
 class RolloutRecorder:
     """Streams one rollout to an .rrd file on a `sim_time` timeline."""
 
@@ -48,8 +57,11 @@ class RolloutRecorder:
             rec.log("world/head", rr.Points3D([head], radii=0.008, colors=[[255, 200, 0]]))
             rec.log("plots/head_attitude_deg", rr.Scalars(float(physics.head_attitude())))
         if hasattr(env.task, "target_position"):
-            target = _to_3d(env.task.target_position)
-            if not self.targets or self.targets[-1] != target:
+            target = _target_in_world(env)
+            if hasattr(physics, "from_trunk_frame"):  # robostrich_a1: the target walks with the trunk
+                if not self.targets and hasattr(env.task, "world_targets"):  # narrow_gap's are fixed
+                    self.targets = [_to_3d(t) for t in env.task.world_targets]
+            elif not self.targets or self.targets[-1] != target:
                 self.targets.append(target)
             rec.log("world/target", rr.Points3D([target], radii=0.012, colors=[[230, 40, 40]]))
         if action is not None:

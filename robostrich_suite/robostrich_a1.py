@@ -87,7 +87,9 @@ def head_stabilize(time_limit=tasks.HEAD_STABILIZE_TIME_LIMIT, random=None,
 def narrow_gap(time_limit=None, random=None, environment_kwargs=None, arm_spec=None,
                tendon_layout=None, steps_per_target=tasks.NARROW_GAP_STEPS_PER_TARGET,
                **task_kwargs):
-    """Sec. 5.2.2: walk to the wall, then the head tracks the six sub-targets of Fig. 10."""
+    """Sec. 5.2.2: walk to the wall, then the head tracks the six sub-targets of Fig. 10,
+    ``steps_per_target`` control steps each (``switch="reached"``: the next one once the
+    head is within the position tolerance of the current one; see ``tasks.NarrowGap``)."""
     task = tasks.NarrowGap(steps_per_target=steps_per_target, random=random, reward="lesson2",
                            **task_kwargs)
     if time_limit is None:

@@ -226,12 +226,25 @@ class QuadrupedReach(_QuadrupedTaskMixin, reach.Reach):
 
 
 class NarrowGap(_QuadrupedTaskMixin, reach.Track):
-    """Walk up to the wall, stop, track ``GAP_TARGETS`` (fixed in the world) in order."""
+    """Walk up to the wall, stop, track ``GAP_TARGETS`` (fixed in the world) in order.
 
-    def __init__(self, stop_distance: float = GAP_STOP_DISTANCE, **kwargs):
+    ``switch`` says when the next sub-target becomes active: ``"time"`` (default, as
+    ``track``): every ``steps_per_target`` control steps, the same schedule for every
+    policy; ``"reached"``: once the head is within ``position_tolerance`` of the current
+    one (the order is enforced, a policy that misses one stays on it).  With the time
+    schedule sub-targets 1-3 are active while the quadruped still walks towards the
+    wall (it stops ~4 s in), farther ahead of the arm's base than the head reaches.
+    """
+
+    SWITCHES = ("time", "reached")
+
+    def __init__(self, stop_distance: float = GAP_STOP_DISTANCE, switch: str = "time", **kwargs):
+        if switch not in self.SWITCHES:
+            raise ValueError(f"unknown switch {switch!r}; use one of {list(self.SWITCHES)}")
         kwargs.setdefault("targets", GAP_TARGETS)
         kwargs.setdefault("steps_per_target", NARROW_GAP_STEPS_PER_TARGET)
         super().__init__(legs="walk", **kwargs)
+        self.switch = switch
         self.stop_distance = float(stop_distance)
         self.world_targets = np.asarray(self.targets, float) + [scenes.GAP_WALL_X, 0.0]
         self._stopped_at = None
@@ -243,6 +256,13 @@ class NarrowGap(_QuadrupedTaskMixin, reach.Track):
     def update_target(self, physics) -> None:
         x, z = self.world_targets[self.target_index]
         self.target_position = physics.to_trunk_frame([x, 0.0, z])[[0, 2]]
+
+    def active_target_index(self, physics) -> int:
+        if self.switch == "time":
+            return super().active_target_index(physics)
+        self.update_target(physics)  # the trunk moved this step
+        reached = self.position_error(physics) <= self.position_tolerance
+        return min(self.target_index + int(reached), len(self.targets) - 1)
 
     def leg_targets(self, physics) -> np.ndarray:
         """Trot until the arm's base is ``stop_distance`` from the wall, then stand

@@ -281,6 +281,12 @@ class Track(Reach):
         self._step = 0
         self.target_index = 0
         super().initialize_episode(physics)
+        # dm_control's base Task calls after_step once while initialising: that is no step of
+        # the episode, so the first target keeps its full steps_per_target.
+        self._step = 0
+        if self.target_index != 0:
+            self.target_index = 0
+            self.target_position = self.targets[0].copy()
 
     def next_target(self) -> np.ndarray:
         return self.targets[self.target_index].copy()
@@ -288,10 +294,15 @@ class Track(Reach):
     def after_step(self, physics):
         super().after_step(physics)
         self._step += 1
-        index = min(self._step // self.steps_per_target, len(self.targets) - 1)
+        index = self.active_target_index(physics)
         if index != self.target_index:
             self.target_index = index
             self.target_position = self.targets[index].copy()
+
+    def active_target_index(self, physics) -> int:
+        """The target after this step: by time, ``steps_per_target`` control steps each
+        (a subclass may switch on something else, e.g. ``NarrowGap(switch="reached")``)."""
+        return min(self._step // self.steps_per_target, len(self.targets) - 1)
 
     def get_observation(self, physics):
         obs = super().get_observation(physics)
