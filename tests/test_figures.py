@@ -9,7 +9,7 @@ import pytest
 from agents import evaluation, figures
 from agents.replay import ObservationFlattener
 from agents.curriculum import make_environment
-from robostrich_suite.studies import movement, walk
+from robostrich_suite.studies import movement, movement_figure, walk, walk_figure
 from robostrich_suite.tasks import quadruped_tasks
 
 
@@ -43,7 +43,7 @@ def _panel_titles(fig, count):
 def rolling():
     """The default rolling test, quick ramps: 50 mm asked, each slip clipped to its range."""
     run = movement.run(movement.MovementConfig("rolling", ramp_time=0.25))
-    fig = movement.movement_figure(run)
+    fig = movement_figure.movement_figure(run)
     yield run, fig
     plt.close(fig)
 
@@ -87,7 +87,7 @@ def walk_series():
 
 
 def test_walk_draws_the_target_p_d_and_the_trunk_height_on_its_own_scale(walk_series):
-    fig = walk.walk_figure(walk_series, "head_stabilize")
+    fig = walk_figure.walk_figure(walk_series, "head_stabilize")
     try:
         titles = _panel_titles(fig, 5)
         assert [t[:3] for t in titles] == ["(A)", "(B)", "(C)", "(D)", "(E)"]
@@ -102,7 +102,7 @@ def test_walk_draws_the_target_p_d_and_the_trunk_height_on_its_own_scale(walk_se
 
 
 def test_walk_legends_sit_beside_the_data_not_on_it(walk_series):
-    fig = walk.walk_figure(walk_series)
+    fig = walk_figure.walk_figure(walk_series)
     try:
         renderer = _draw(fig)
         for ax in fig.axes:

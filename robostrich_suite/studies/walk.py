@@ -14,17 +14,13 @@ import argparse
 import collections
 import pathlib
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-import robostrich_suite  # noqa: E402
-from robostrich_suite import physics as physics_lib  # noqa: E402
-from robostrich_suite import rerun_log  # noqa: E402
-from robostrich_suite.robostrich_a1 import CONTROL_TIMESTEP, SUITE  # noqa: E402
-from robostrich_suite.tasks import gait as gait_lib  # noqa: E402
+import robostrich_suite
+from robostrich_suite import physics as physics_lib
+from robostrich_suite import rerun_log
+from robostrich_suite.robostrich_a1 import CONTROL_TIMESTEP, SUITE
+from robostrich_suite.tasks import gait as gait_lib
 
 
 def scripted_tendons(kind: str, control_range: np.ndarray, dorsal: int):
@@ -103,53 +99,6 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
     return {key: np.array(value) for key, value in series.items()}
 
 
-def walk_figure(series: dict, title: str = ""):
-    """Heights, speeds, head distance ahead of the trunk and angles over time, one panel each;
-    the trunk height has its own panel so its dip is not flattened by the head's scale."""
-    t = series["time"]
-    fig, axes = plt.subplots(5, 1, figsize=(11, 12), sharex=True)
-    axes[0].plot(t, series["head_height"], label="head height")
-    axes[0].plot(t, series["target_height"], "--", color="k", lw=1, label="target head height")
-    axes[0].set_ylabel("height above\nground (m)")
-    axes[0].set_title("(A) head height", fontsize=10)
-    axes[1].plot(t, series["trunk_height"], color="C1", label="trunk height")
-    axes[1].plot(t, series["height_command"], "--", color="C2", label="trunk height command")
-    axes[1].set_ylabel("height above\nground (m)")
-    axes[1].set_title("(B) trunk height and its command (own scale, so a commanded dip shows)",
-                      fontsize=10)
-    axes[2].plot(t, series["trunk_speed"], label="trunk forward speed")
-    axes[2].plot(t, series["head_speed"], label="head speed (3-D)", alpha=0.8)
-    axes[2].plot(t, series["head_vertical_speed"], label="head vertical speed", alpha=0.8)
-    axes[2].set_ylabel("speed (m/s)")
-    axes[2].set_title("(C) speeds", fontsize=10)
-    axes[3].plot(t, series["head_forward_distance"], label="head ahead of trunk centre")
-    axes[3].plot(t, series["target_forward"], "--", color="k", lw=1, label="target $P_d$")
-    axes[3].set_ylabel("distance (m)")
-    axes[3].set_title("(D) head distance ahead of the trunk centre and its target $P_d$",
-                      fontsize=10)
-    axes[4].plot(t, series["head_attitude"], label="head attitude (90 = level)")
-    axes[4].plot(t, series["trunk_pitch"], label="trunk pitch (nose down +)")
-    axes[4].set_ylabel("angle (deg)")
-    axes[4].set_xlabel("time (s)")
-    axes[4].set_title("(E) head attitude and trunk pitch", fontsize=10)
-    for axis in axes:
-        axis.grid(alpha=0.3)
-        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    return fig
-
-
-def plot_walk(series: dict, path, title: str = "") -> None:
-    """Write :func:`walk_figure` to ``path`` (PNG)."""
-    fig = walk_figure(series, title)
-    path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-
-
 def _at_least_one_step(text: str) -> float:
     import argparse
     try:
@@ -175,6 +124,7 @@ def out_directory_problem(out: pathlib.Path) -> str | None:
 
 def main(argv=None) -> None:
     """The walk tool: trot with scripted tendons, write a Rerun recording and a PNG."""
+    from robostrich_suite.studies import walk_figure
     parser = argparse.ArgumentParser(
         description="Walk the quadruped with the arm on it; write walk.rrd and walk.png under --out "
                     "(trunk and head height, speed and attitude over time).")
@@ -200,7 +150,7 @@ def main(argv=None) -> None:
     rrd = None if args.no_rrd else args.out / "walk.rrd"
     series = record_walk(args.task, args.seconds, args.tendons, gait, rrd, args.seed)
     png = args.out / "walk.png"
-    plot_walk(series, png, f"robostrich_a1/{args.task}, tendons: {args.tendons}")
+    walk_figure.plot_walk(series, png, f"robostrich_a1/{args.task}, tendons: {args.tendons}")
     walked = np.sum(series["trunk_speed"]) * CONTROL_TIMESTEP
     print(f"{len(series['time'])} steps, {series['time'][-1]:.2f} s: "
           f"mean forward speed {walked / series['time'][-1]:.3f} m/s, "
