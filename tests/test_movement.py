@@ -14,11 +14,6 @@ paper's difference.  On the tasks' arm (every ventral tendon from the base, dors
 one-parameter family whose attitude is a function of the head position (tested
 below); numbers and reasons in docs/movement.md.
 """
-import shutil
-import subprocess
-import sys
-import pathlib
-
 import numpy as np
 import pytest
 
@@ -119,21 +114,12 @@ def test_lever_amplitude_is_matched_to_the_rolling_head_travel():
     assert lever.head_travel() == pytest.approx(travel, rel=0.1)
 
 
-def _rerun_cli():
-    candidate = pathlib.Path(sys.executable).parent / "rerun"
-    return str(candidate) if candidate.exists() else shutil.which("rerun")
-
-
-def test_command_line_writes_figures_and_valid_recordings(tmp_path):
+def test_command_line_writes_figures_and_valid_recordings(tmp_path, verify_rrd):
     results = movement.main(["--out", str(tmp_path), "--ramp-time", "0.25", "--no-progress",
                              "--no-match-travel"])
     assert set(results) == set(movement.PATTERNS)
-    cli = _rerun_cli()
-    assert cli, "the rerun command of rerun-sdk is not installed"
     for pattern in movement.PATTERNS:
         png = tmp_path / f"{pattern}.png"
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
-        rrd = tmp_path / f"{pattern}.rrd"
-        assert rrd.stat().st_size > 100_000
-        check = subprocess.run([cli, "rrd", "verify", str(rrd)], capture_output=True, text=True)
-        assert check.returncode == 0, check.stderr
+        assert (tmp_path / f"{pattern}.rrd").stat().st_size > 100_000
+    verify_rrd(*(tmp_path / f"{pattern}.rrd" for pattern in movement.PATTERNS))
