@@ -29,7 +29,10 @@ def make_learner(seed=0, config=TINY):
 
 
 def leaves(tree):
-    return [np.asarray(x) for x in jax.tree_util.tree_leaves(tree)]
+    """The arrays of a parameter tree; never none, so comparing two trees leaf by leaf cannot pass vacuously."""
+    arrays = [np.asarray(x) for x in jax.tree_util.tree_leaves(tree)]
+    assert arrays, "an empty tree"
+    return arrays
 
 
 def test_critic_loss_falls_on_a_fixed_batch():
@@ -46,7 +49,7 @@ def test_update_is_deterministic_for_a_seed_and_differs_across_seeds():
     a, b, c = make_learner(seed=3), make_learner(seed=3), make_learner(seed=4)
     ma, mb = a.step(batches), b.step(batches)
     c.step(batches)
-    for x, y in zip(leaves(a.state), leaves(b.state)):
+    for x, y in zip(leaves(a.state), leaves(b.state), strict=True):
         np.testing.assert_array_equal(x, y)
     assert float(ma["critic_loss"]) == float(mb["critic_loss"])
     assert any(not np.array_equal(x, y) for x, y in zip(leaves(a.state.policy_params), leaves(c.state.policy_params)))
@@ -59,7 +62,7 @@ def test_scan_of_k_updates_equals_k_single_updates():
     a.step(batches)
     for i in range(4):
         b.step(Transitions(*(x[i:i + 1] for x in batches)))
-    for x, y in zip(leaves(a.state), leaves(b.state)):
+    for x, y in zip(leaves(a.state), leaves(b.state), strict=True):
         np.testing.assert_allclose(x, y, rtol=1e-5, atol=1e-6)
 
 

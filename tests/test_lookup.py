@@ -77,9 +77,13 @@ def test_evaluation_on_reacher_reports_returns_not_nan(tmp_path):
     summary = reports["heldout"]["summary"]
     assert set(summary) == {"episodes", "return_mean", "return_std", "return_min", "return_max"}
     assert summary["episodes"] == 2 and all(np.isfinite(v) for v in summary.values())
-    assert summary["return_min"] <= summary["return_mean"] <= summary["return_max"]
     text = open(os.path.join(tmp_path, "ev", "sac_heldout.json")).read()
-    assert "NaN" not in text and json.loads(text)["episodes"][0]["steps"] == 1000
+    episodes = json.loads(text)["episodes"]
+    assert "NaN" not in text and [e["steps"] for e in episodes] == [1000, 1000]
+    returns = [e["return"] for e in episodes]  # the summary is of the episodes written beside it
+    assert (summary["return_min"], summary["return_max"]) == (min(returns), max(returns))
+    assert summary["return_mean"] == pytest.approx(np.mean(returns))
+    assert 0.0 <= min(returns) and max(returns) <= 1000  # reacher pays at most 1 per step
     assert evaluation.evaluate_lookup(str(tmp_path / "ev"), "reacher", "easy", None) is None
 
 
@@ -130,6 +134,7 @@ def test_untrained_residual_agent_is_the_lookup(flattener, tmp_path):
     target = targets.heldout_targets()[:2]
     agent = evaluation.evaluate_heldout(actor, run.loop.flattener, "robostrich", "lesson2", targets=target)
     base = evaluation.evaluate_heldout(LookupPolicy(flattener), flattener, "robostrich", "lesson2", targets=target)
+    assert len(agent["episodes"]) == len(base["episodes"]) == 2
     for a, b in zip(agent["episodes"], base["episodes"]):
         assert a["final_position_error"] == pytest.approx(b["final_position_error"], abs=1e-9)
     run.run()  # training moves it: after 100 steps with updates the policy is no longer exactly zero

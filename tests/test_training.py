@@ -18,11 +18,14 @@ TINY_ARGS = ["--domain", "point_mass", "--hidden", "32,32", "--batch-size", "32"
 
 
 def leaves(tree):
-    return [np.asarray(x) for x in jax.tree_util.tree_leaves(tree)]
+    """The arrays of a parameter tree; never none, so comparing two trees leaf by leaf cannot pass vacuously."""
+    arrays = [np.asarray(x) for x in jax.tree_util.tree_leaves(tree)]
+    assert arrays, "an empty tree"
+    return arrays
 
 
 def assert_same_run(a: CurriculumRun, b: CurriculumRun):
-    for x, y in zip(leaves(a.loop.learner.state), leaves(b.loop.learner.state)):
+    for x, y in zip(leaves(a.loop.learner.state), leaves(b.loop.learner.state), strict=True):
         np.testing.assert_array_equal(x, y)
     np.testing.assert_array_equal(np.asarray(a.loop.actor.key), np.asarray(b.loop.actor.key))
     assert a.loop.env_steps == b.loop.env_steps and a.loop.episodes == b.loop.episodes
@@ -65,7 +68,7 @@ def test_killed_and_resumed_run_matches_an_uninterrupted_one(tmp_path):
     assert a["loop"]["transitions"] == b["loop"]["transitions"] == 600  # action repeat 2
     assert (a["lesson_index"], a["lesson_steps"]) == (b["lesson_index"], b["lesson_steps"]) == (2, 0)
     assert int(a["learner"].steps) == int(b["learner"].steps) > 0
-    for x, y in zip(leaves(a["learner"]), leaves(b["learner"])):
+    for x, y in zip(leaves(a["learner"]), leaves(b["learner"]), strict=True):
         np.testing.assert_array_equal(x, y)
     for name in ("metrics.jsonl", "evals.jsonl"):  # no duplicated records after the resume
         ra, rb = (open(os.path.join(d, "curriculum", name)).read().splitlines() for d in (whole, killed))
@@ -146,7 +149,7 @@ def test_runs_trained_in_worker_processes_equal_runs_trained_in_turn(tmp_path):
     for label in ("curriculum", "baseline"):
         a = checkpoint.load(str(tmp_path / "1" / label / "checkpoint.pkl"), None)
         b = checkpoint.load(str(tmp_path / "2" / label / "checkpoint.pkl"), None)
-        for x, y in zip(leaves(a["learner"]), leaves(b["learner"])):
+        for x, y in zip(leaves(a["learner"]), leaves(b["learner"]), strict=True):
             np.testing.assert_array_equal(x, y)
 
 
