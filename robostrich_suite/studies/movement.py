@@ -49,8 +49,6 @@ class MovementConfig:
     release: bool = True  # rolling: release each tendon while the next one contracts
     ventral_span: int | None = 4  # ventral slips this many joints long; None: from the base
     lever_amplitude: float | None = None  # lever's ventral contraction (default: amplitude)
-    input_noise: float = 0.0  # m, std of Gaussian noise on the ventral inputs per control step
-    seed: int = 0  # of the input noise
 
     def validate(self, num_ventral: int) -> None:
         if self.pattern not in PATTERNS:
@@ -209,8 +207,6 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
         rerun_log.log_geometry(recording, physics)
 
     physics.reset()
-    rng = np.random.default_rng(config.seed)
-    noise = np.zeros(model.nu)
     dorsal_input = 0.0
     rows = []
     iterator = range(steps + 1)
@@ -220,10 +216,6 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
     for k in iterator:
         t = k * dt
         x = targets(t)
-        if config.input_noise > 0:
-            if k % RECORD_EVERY == 0:  # a new draw each control step (0.008 s)
-                noise[ventral] = config.input_noise * rng.standard_normal(len(ventral))
-            x = np.clip(x + noise, *model.actuator_ctrlrange.T)
         contraction = physics.tendon_contractions()
         if config.dorsal_hold == "length":
             dorsal_input = hold_dorsal_length(dorsal_input, x[dorsal], contraction[dorsal], dt,
@@ -408,12 +400,8 @@ def main(argv=None) -> dict:
                              "until its head travel equals the rolling pattern's")
     parser.add_argument("--joint-stiffness", type=float, default=None,
                         help="override the passive joint stiffness, N m/rad (default: the arm's)")
-    parser.add_argument("--input-noise", type=float, default=0.0,
-                        help="std (m) of Gaussian noise added to the ventral inputs every "
-                             "control step, to see how robust a pattern is (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0,
-                        help="seed of the input noise; without noise the tests are "
-                             "deterministic (default: %(default)s)")
+                        help="seed of --pose-family's random inputs (default: %(default)s)")
     parser.add_argument("--pose-family", type=int, default=0, metavar="N",
                         help="also settle N random ventral inputs at the held dorsal length and "
                              "print how tightly the attitude follows the head position "
@@ -426,7 +414,7 @@ def main(argv=None) -> dict:
     spec = arm_lib.ArmSpec.from_table1(**overrides)
     setting = dict(ventral_span=args.ventral_span, dorsal=args.dorsal, amplitude=args.amplitude,
                    ramp_time=args.ramp_time, dorsal_hold=args.dorsal_hold,
-                   release=not args.no_release, input_noise=args.input_noise, seed=args.seed)
+                   release=not args.no_release)
     if args.paper_layout:
         setting.update(PAPER_LAYOUT)
     base = MovementConfig(**setting)
