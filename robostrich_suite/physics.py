@@ -104,11 +104,6 @@ def ventral_indices(model) -> list[int]:
     return [i for i, side in enumerate(tendon_sides(model)) if side == "ventral"]
 
 
-def head_position(physics) -> np.ndarray:
-    """World position (x, y, z) of the head site of an attached arm."""
-    return np.array(physics.named.data.site_xpos[arm_lib.HEAD_SITE_PATH])
-
-
 def head_axis(physics) -> np.ndarray:
     """World direction of the head's long axis (the head body's z axis)."""
     site_id = physics.model.name2id(arm_lib.HEAD_SITE_PATH, "site")
@@ -151,15 +146,6 @@ def _continuous_attitude(axis_angle_rad: float, joint_angles_rad: np.ndarray) ->
     axis_angle = math.degrees(axis_angle_rad)
     turns = (math.degrees(joint_angles_rad.sum()) - axis_angle) / 360.0
     return axis_angle + 360.0 * round(turns) if math.isfinite(turns) else math.nan
-
-
-def head_attitude_deg(physics) -> float:
-    """Head attitude in the world's x-z plane: 0 up, 90 level (paper Fig. 2B), 180 down,
-    continuous past 180 (see :func:`continuous_attitude_deg`)."""
-    axis = head_axis(physics)
-    qpos_adr = arm_indices(physics.model).qpos[::-1]  # caudal first, as the sum always was
-    return float(continuous_attitude_deg(float(np.degrees(np.arctan2(axis[0], axis[2]))),
-                                         physics.data.qpos[qpos_adr]))
 
 
 class _MujocoWarningCapture(logging.Filter):
