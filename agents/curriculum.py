@@ -49,14 +49,17 @@ def format_plan(plan: Sequence[Lesson]) -> str:
 
 
 def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, task_kwargs: Optional[dict] = None,
-                 layout: Optional[str] = None) -> dict:
+                 layout: Optional[str] = None, init_from: Optional[str] = None) -> dict:
     """What makes two runs the same run: the part of a checkpoint's fingerprint known before building it
-    (robostrich-train checks a resume against it before touching anything)."""
+    (robostrich-train checks a resume against it before touching anything).  ``init_from``: the content
+    hash of the checkpoint the run started from (agents/transfer.py), if any."""
     identity = {"config": config.to_dict(), "plan": format_plan(plan), "seed": seed}
     if task_kwargs:
         identity["task_kwargs"] = dict(task_kwargs)
     if layout is not None:
         identity["layout"] = layout
+    if init_from is not None:
+        identity["init_from"] = init_from
     return identity
 
 
@@ -89,11 +92,15 @@ class CurriculumRun:
 
     def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
                  checkpoint_every: int = 10_000, env_factory: Callable = make_environment, name: str = "run",
-                 task_kwargs: Optional[dict] = None, layout: Optional[str] = None):
+                 task_kwargs: Optional[dict] = None, layout: Optional[str] = None,
+                 init_from: Optional[str] = None):
         """``task_kwargs`` go to every lesson's task (e.g. eq. 10's ``weights``); ``layout`` names a
-        built-in tendon layout of the arm domains (its own targets come with it)."""
+        built-in tendon layout of the arm domains (its own targets come with it); ``init_from`` is the
+        content hash of the checkpoint whose learner this run starts from (agents/transfer.initialize
+        puts it there), kept in the fingerprint."""
         self.task_kwargs = dict(task_kwargs or {})
         self.layout = layout
+        self.init_from = init_from
         for lesson in plan:  # an unknown layout or a layout on dm_control fails here, not mid-run
             as_domain(lesson.domain, layout)
         self.plan = list(plan)
@@ -135,7 +142,7 @@ class CurriculumRun:
 
     # -- checkpoints -----------------------------------------------------------------------
     def fingerprint(self) -> dict:
-        return {**run_identity(self.plan, self.config, self.seed, self.task_kwargs, self.layout),
+        return {**run_identity(self.plan, self.config, self.seed, self.task_kwargs, self.layout, self.init_from),
                 "observation_layout": self.loop.flattener.describe(),
                 "action_size": self.loop.actor.adapter.size}
 

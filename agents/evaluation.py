@@ -272,7 +272,8 @@ def load_run_from_checkpoint(path: str):
     scratch = tempfile.mkdtemp(prefix="robostrich-evaluate-")  # the run's own files are left untouched
     try:
         run = CurriculumRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch,
-                            task_kwargs=fp.get("task_kwargs"), layout=fp.get("layout"))
+                            task_kwargs=fp.get("task_kwargs"), layout=fp.get("layout"),
+                            init_from=fp.get("init_from"))
         run.restore(path)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)

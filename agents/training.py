@@ -110,6 +110,14 @@ def build_parser():
     p.add_argument("--layout", default=None,
                    help="built-in tendon layout of the arm (robostrich-layouts --list); its own shipped level "
                         "poses give the training and held-out targets and the lookup table (default: the paper's)")
+    p.add_argument("--init-from", default=None, metavar="CHECKPOINT",
+                   help="start the curriculum's learner (policy, critics, target critics, optimiser states, "
+                        "temperature) from a checkpoint.pkl of robostrich-train on the same domain or, for "
+                        "--domain robostrich_a1, on robostrich (the arm on its frame): its networks are mapped "
+                        "onto the a1's observations (agents/transfer.py). Same tendon layout and networks "
+                        "(--hidden) required; the replay is not carried (other observations); the plain-SAC "
+                        "baseline still starts from scratch, so the comparison shows what the transfer brings. "
+                        "A --resume may leave it out (the checkpoint holds the transferred state)")
     p.add_argument("--task-kwargs", type=_json_object, default={},
                    help="JSON object passed to every training lesson's task, e.g. eq. 10's weights: "
                         "'{\"weights\": {\"position_error\": 10}}' (evaluation keeps the task's defaults)")
@@ -204,6 +212,15 @@ def plan_from_args(args):
     return [Lesson(args.domain, t, s) for t, s in zip(tasks, steps)]
 
 
+def _previous_init_path(out: str) -> Optional[str]:
+    """The --init-from path config.json recorded when this run started (a --resume may leave it out)."""
+    try:
+        with open(os.path.join(out, "config.json")) as f:
+            return (json.load(f).get("init_from") or {}).get("path")
+    except (OSError, ValueError):
+        return None
+
+
 def read_jsonl(path):
     if not os.path.exists(path):
         return []
@@ -240,6 +257,8 @@ class RunSpec:
     checkpoint_every: int
     task_kwargs: Optional[dict]
     layout: Optional[str]
+    init_from: Optional[str] = None  # a checkpoint to start a fresh run's learner from (agents/transfer.py)
+    init_digest: Optional[str] = None  # its content hash, kept in the run's fingerprint
 
     @property
     def total_steps(self) -> int:
@@ -250,9 +269,12 @@ class RunSpec:
         damaged or mismatched checkpoint, never restarts silently)."""
         run = CurriculumRun(list(self.plan), self.config, self.seed, self.run_dir,
                             checkpoint_every=self.checkpoint_every, name=self.label,
-                            task_kwargs=self.task_kwargs, layout=self.layout)
+                            task_kwargs=self.task_kwargs, layout=self.layout, init_from=self.init_digest)
         if restore and os.path.exists(run.checkpoint_path):
             run.restore()
+        elif self.init_from is not None:
+            from agents import transfer
+            transfer.initialize(run, self.init_from, self.init_digest)
         return run
 
 
@@ -393,12 +415,24 @@ def main(argv=None):
                  else f"{args.out} does not exist")
         raise FileNotFoundError(f"--resume: nothing to resume: {where}; check --out, or leave out --resume "
                                 "to start a fresh run")
+    init = {}  # the curriculum's --init-from: (path, content hash)
+    if args.init_from is not None:
+        from agents import transfer
+        source = transfer.check_source(args.init_from, plan, config, args.layout)
+        init = {"init_from": source.path, "init_digest": source.digest}
     if args.resume:  # damaged or another configuration: refuse before building anything or touching a file
         from agents import checkpoint
         for label in existing:
             path = os.path.join(args.out, label, "checkpoint.pkl")
-            expected = run_identity(run_plans[label], config, args.seed, args.task_kwargs, args.layout)
             stored = checkpoint.read_fingerprint(path)
+            if label == "curriculum":  # a started run's learner is in its checkpoint: --init-from may be left out
+                if init and stored.get("init_from") != init["init_digest"]:
+                    raise ValueError(f"{path} did not start from --init-from {args.init_from} "
+                                     + ("(nor from any checkpoint)" if "init_from" not in stored else
+                                        "(it started from another checkpoint, or that file has changed since)"))
+                init = {**init, "init_digest": stored["init_from"]} if "init_from" in stored else {}
+            expected = run_identity(run_plans[label], config, args.seed, args.task_kwargs, args.layout,
+                                    init.get("init_digest") if label == "curriculum" else None)
             checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
     os.makedirs(args.out, exist_ok=True)
 
@@ -407,7 +441,8 @@ def main(argv=None):
     eval_at = sorted(set(boundaries) | set(range(eval_every, total + 1, eval_every)))
 
     specs = {label: RunSpec(label, tuple(run_plan), config, args.seed, os.path.join(args.out, label),
-                            args.checkpoint_every, args.task_kwargs, args.layout)
+                            args.checkpoint_every, args.task_kwargs, args.layout,
+                            **(init if label == "curriculum" else {}))  # the baseline starts from scratch
              for label, run_plan in run_plans.items()}
     workers = args.workers if args.stop_at_step is None else 1  # the kill hook raises in this process
     parallel = workers > 1 and len(specs) > 1
@@ -423,6 +458,8 @@ def main(argv=None):
     evaluation.write_json(os.path.join(args.out, "config.json"), {
         "argv": sys.argv if argv is None else list(argv), "config": config.to_dict(),
         "task_kwargs": args.task_kwargs, "layout": args.layout,
+        "init_from": {"path": init.get("init_from", _previous_init_path(args.out)), "sha256": init["init_digest"]}
+        if init else None,
         "plans": {k: format_plan(v) for k, v in run_plans.items()}, "seed": args.seed})
 
     out_eval = os.path.join(args.out, "evaluation")

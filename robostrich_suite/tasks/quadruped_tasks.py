@@ -89,10 +89,31 @@ def default_target_pool() -> np.ndarray:
     return frame_to_trunk(targets.training_targets())
 
 
+# (x, z) on the frame -> (forward, up) on the standing A1: the arm's base moves from the
+# frame's neck base to the mount on the trunk at the standing height.
+FRAME_TO_TRUNK_OFFSET = np.array([scenes.MOUNT_OFFSET[0], scenes.NOMINAL_MOUNT_HEIGHT - scenes.FRAME_MOUNT_HEIGHT])
+
+
 def frame_to_trunk(frame_targets) -> np.ndarray:
     """(x, z) head positions of the arm on its frame -> (forward, up) on the standing A1."""
     frame_targets = reach.as_targets(frame_targets, "targets")
-    return frame_targets + [scenes.MOUNT_OFFSET[0], scenes.NOMINAL_MOUNT_HEIGHT - scenes.FRAME_MOUNT_HEIGHT]
+    return frame_targets + FRAME_TO_TRUNK_OFFSET
+
+
+# The observations of these tasks in terms of ``robostrich``'s (the arm on its frame), for
+# starting a1 training from an agent trained on the frame (agents/transfer.py).  Per key,
+# the frame's (key, component) that each component equals, None for an input the frame
+# arm has not (the trunk's motion, the sideways 'left' component); keys not listed are the
+# frame's own, component by component.  On a standing, level quadruped at the nominal
+# height the arm is where the frame holds it, moved by FRAME_TO_TRUNK_OFFSET: the frame's
+# FRAME_POSITION_KEYS add it, velocities, to_target and the rest are unchanged.
+FRAME_OBSERVATION_SOURCES = {
+    "head_position": (("head_position", 0), None, ("head_position", 1)),  # forward, left, up
+    "head_velocity": (("head_velocity", 0), None, ("head_velocity", 1)),
+    "trunk_position": (None, None, None),
+    "trunk_velocity": (None, None, None),
+}
+FRAME_POSITION_KEYS = ("head_position", "target_position")
 
 
 _LEFT_SIGN = np.array([1.0 if leg.endswith("L") else -1.0 for leg in quad.LEGS])
