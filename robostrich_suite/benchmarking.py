@@ -24,3 +24,9 @@ def random_actions(domain: str, task: str, count: int = 500, seed: int = 0) -> n
     spec = robostrich_suite.load(domain, task, task_kwargs=dict(random=0)).action_spec()
     return np.random.default_rng(seed).uniform(spec.minimum, spec.maximum,
                                                size=(count,) + spec.shape)
+
+
+def episode_steps(domain: str, task: str) -> int:
+    """Control steps per episode of ``robostrich_suite.load(domain, task)``."""
+    env = robostrich_suite.load(domain, task, task_kwargs=dict(random=0))
+    return int(env._step_limit)  # dm_control keeps the time limit only as this step count

@@ -169,3 +169,16 @@ def test_input_sensitivity_stored_inputs_hold_their_targets_and_errors_cost_succ
     bad = subprocess.run([sys.executable, os.path.join(TOOLS, "input_sensitivity.py"), "--errors", "2"],
                          capture_output=True, text=True, env=tool_env, cwd=tmp_path)
     assert bad.returncode == 2 and "fractions in [0, 1]" in bad.stderr.strip().splitlines()[-1]
+
+
+def test_env_benchmark_resets_its_raw_baseline_like_the_environment(capsys):
+    """The raw mj_step baseline runs the same episodes as the environment (lesson 2: 250 control
+    steps from the fixed start), and the tool prints both rates and their ratio."""
+    tool = load_tool("benchmark_env")
+    from robostrich_suite import benchmarking
+    assert benchmarking.episode_steps("robostrich", "lesson2") == 250
+    assert benchmarking.episode_steps("robostrich", "track") == 750
+    tool.main(["--steps", "300", "--repeats", "1"])
+    lines = capsys.readouterr().out.splitlines()
+    ratio = float(lines[-1].split(":")[1])
+    assert lines[0].startswith("raw mj_step") and 0.05 < ratio < 1.5
