@@ -93,11 +93,14 @@ class CurriculumRun:
     def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
                  checkpoint_every: int = 10_000, env_factory: Callable = make_environment, name: str = "run",
                  task_kwargs: Optional[dict] = None, layout: Optional[str] = None,
-                 init_from: Optional[str] = None):
+                 init_from: Optional[str] = None, keep_lesson_checkpoints: bool = False):
         """``task_kwargs`` go to every lesson's task (e.g. eq. 10's ``weights``); ``layout`` names a
         built-in tendon layout of the arm domains (its own targets come with it); ``init_from`` is the
         content hash of the checkpoint whose learner this run starts from (agents/transfer.initialize
-        puts it there), kept in the fingerprint."""
+        puts it there), kept in the fingerprint. ``keep_lesson_checkpoints`` also writes a checkpoint
+        at the end of every lesson but the last, ``after_lessonK.pkl`` (K lessons done), which
+        robostrich-evaluate and the application tools load as the policy of the first K lessons."""
+        self.keep_lesson_checkpoints = bool(keep_lesson_checkpoints)
         self.task_kwargs = dict(task_kwargs or {})
         self.layout = layout
         self.init_from = init_from
@@ -120,6 +123,10 @@ class CurriculumRun:
         lesson = self.plan[index]
         return self.env_factory(self.domain(lesson), lesson.task, self.seed + 1000 * (index + 1),
                                 **self.task_kwargs)
+
+    def lesson_checkpoint_path(self, lessons_done: int) -> str:
+        """Where ``keep_lesson_checkpoints`` writes the checkpoint after ``lessons_done`` lessons."""
+        return os.path.join(self.run_dir, f"after_lesson{lessons_done}.pkl")
 
     def domain(self, lesson: Optional[Lesson] = None):
         """The agents.domains.Domain of `lesson` (default: the last), with this run's layout."""
@@ -226,6 +233,8 @@ class CurriculumRun:
                     self.lesson_steps = 0
                     if not self.done:
                         loop.set_environment(self._make_lesson_env(self.lesson_index))
+                        if self.keep_lesson_checkpoints:
+                            self.save_checkpoint(self.lesson_checkpoint_path(self.lesson_index))
                 if on_eval is not None and any(before < s <= loop.env_steps for s in eval_at):
                     metrics_file.flush()
                     on_eval(self)

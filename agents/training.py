@@ -121,6 +121,9 @@ def build_parser():
     p.add_argument("--task-kwargs", type=_json_object, default={},
                    help="JSON object passed to every training lesson's task, e.g. eq. 10's weights: "
                         "'{\"weights\": {\"position_error\": 10}}' (evaluation keeps the task's defaults)")
+    p.add_argument("--keep-lesson-checkpoints", action="store_true",
+                   help="also keep a checkpoint after every lesson but the last (RUN/after_lessonK.pkl), "
+                        "e.g. the lesson-3 policy to compare lesson 4 with (robostrich-stabilize --reference)")
     p.add_argument("--checkpoint-every", type=positive_int, default=25_000,
                    help="environment steps between checkpoints (default: %(default)s)")
     p.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
@@ -259,6 +262,7 @@ class RunSpec:
     layout: Optional[str]
     init_from: Optional[str] = None  # a checkpoint to start a fresh run's learner from (agents/transfer.py)
     init_digest: Optional[str] = None  # its content hash, kept in the run's fingerprint
+    keep_lesson_checkpoints: bool = False  # also a checkpoint after every lesson but the last
 
     @property
     def total_steps(self) -> int:
@@ -269,7 +273,8 @@ class RunSpec:
         damaged or mismatched checkpoint, never restarts silently)."""
         run = CurriculumRun(list(self.plan), self.config, self.seed, self.run_dir,
                             checkpoint_every=self.checkpoint_every, name=self.label,
-                            task_kwargs=self.task_kwargs, layout=self.layout, init_from=self.init_digest)
+                            task_kwargs=self.task_kwargs, layout=self.layout, init_from=self.init_digest,
+                            keep_lesson_checkpoints=self.keep_lesson_checkpoints)
         if restore and os.path.exists(run.checkpoint_path):
             run.restore()
         elif self.init_from is not None:
@@ -442,6 +447,7 @@ def main(argv=None):
 
     specs = {label: RunSpec(label, tuple(run_plan), config, args.seed, os.path.join(args.out, label),
                             args.checkpoint_every, args.task_kwargs, args.layout,
+                            keep_lesson_checkpoints=args.keep_lesson_checkpoints,
                             **(init if label == "curriculum" else {}))  # the baseline starts from scratch
              for label, run_plan in run_plans.items()}
     workers = args.workers if args.stop_at_step is None else 1  # the kill hook raises in this process

@@ -160,3 +160,23 @@ def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
     assert not config.critic_layer_norm and config.her_ratio == 0 and config.init_temperature == 1.0
     default = training.config_from_args(training.build_parser().parse_args([]), [])
     assert default == SACConfig()  # the CLI's defaults are the dataclass's
+
+
+def test_lesson_checkpoints_hold_the_policy_after_each_lesson(tmp_path):
+    """--keep-lesson-checkpoints writes RUN/after_lessonK.pkl at the end of every lesson but the
+    last: a whole checkpoint of that moment, which robostrich-evaluate's loader restores."""
+    from agents import evaluation
+    args = TINY_ARGS[:-1] + ["--plan", "point_mass/easy:300,point_mass/hard:300", "--no-baseline",
+                             "--checkpoint-every", "1000", "--keep-lesson-checkpoints",
+                             "--out", str(tmp_path)]
+    training.main(args)
+    kept = tmp_path / "curriculum" / "after_lesson1.pkl"
+    assert sorted(p.name for p in (tmp_path / "curriculum").glob("after_lesson*.pkl")) == [kept.name]
+    state = checkpoint.load(str(kept), None)
+    assert state["lesson_index"] == 1 and state["loop"]["env_steps"] == 300
+    run = evaluation.load_run_from_checkpoint(str(kept))
+    assert run.loop.env_steps == 300 and run.lesson.task == "hard"
+    final = checkpoint.load(str(tmp_path / "curriculum" / "checkpoint.pkl"), None)
+    assert final["loop"]["env_steps"] == 600
+    assert any(not np.array_equal(a, b) for a, b in zip(leaves(state["learner"]), leaves(final["learner"]),
+                                                          strict=True))
