@@ -150,6 +150,24 @@ def rollout(env, policy: Policy, record: Callable, recorder=None) -> dict:
     return series
 
 
+def rollouts(policy: Policy, task: str, seeds: int, gait, record_for: Callable,
+             recording: Optional[str] = None, bar=None, **task_kwargs):
+    """`policy` on `task` over `seeds` gait phases: yields (seed, environment, series) per phase.
+    `record_for(env)` gives :func:`rollout`'s per-step `record`; the phase-0 rollout is recorded
+    to `recording` (a .rrd path; None: no recording)."""
+    for seed in range(seeds):
+        env = make_environment(policy.domain, task, seed, seeds, gait, **task_kwargs)
+        recorder = open_recorder(recording, f"{task} {policy.label}") if seed == 0 else None
+        try:
+            series = rollout(env, policy, record_for(env), recorder)
+        finally:
+            if recorder is not None:
+                recorder.close()
+        yield seed, env, series
+        if bar is not None:
+            bar.update(1)
+
+
 def open_recorder(path: Optional[str], name: str):
     """A Rerun recorder writing `path` (agents/recording.py), or None for no recording."""
     if path is None:

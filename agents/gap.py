@@ -177,21 +177,11 @@ def evaluate(policies: list, seeds: int, gait, record_dir: Optional[str] = None,
     report = {}
     for policy in policies:
         per_seed, first = [], None
-        for seed in range(seeds):
-            env = applications.make_environment(policy.domain, TASK, seed, seeds, gait, **task_kwargs)
-            recorder = None
-            if seed == 0 and record_dir is not None:
-                recorder = applications.open_recorder(os.path.join(record_dir, f"gap_{policy.label}.rrd"),
-                                                      f"narrow_gap {policy.label}")
-            try:
-                series = applications.rollout(env, policy, recorder_for(env), recorder)
-            finally:
-                if recorder is not None:
-                    recorder.close()
+        recording = None if record_dir is None else os.path.join(record_dir, f"gap_{policy.label}.rrd")
+        for seed, env, series in applications.rollouts(policy, TASK, seeds, gait, recorder_for, recording,
+                                                       bar, **task_kwargs):
             per_seed.append({"seed": seed, **metrics(series, env.task.world_targets, env.task.position_tolerance)})
             first = series if first is None else first
-            if bar is not None:
-                bar.update(1)
         report[policy.label] = {"summary": summarize(per_seed), "seeds": per_seed, "series": first}
     return report
 

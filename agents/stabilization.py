@@ -133,21 +133,11 @@ def evaluate(policies: list, seeds: int, gait, settle: float = SETTLE, record_di
     report = {}
     for policy in policies:
         per_seed, first = [], None
-        for seed in range(seeds):
-            env = applications.make_environment(policy.domain, TASK, seed, seeds, gait, **task_kwargs)
-            recorder = None
-            if seed == 0 and record_dir is not None:
-                recorder = applications.open_recorder(os.path.join(record_dir, f"stabilize_{policy.label}.rrd"),
-                                                      f"head_stabilize {policy.label}")
-            try:
-                series = applications.rollout(env, policy, record, recorder)
-            finally:
-                if recorder is not None:
-                    recorder.close()
+        recording = None if record_dir is None else os.path.join(record_dir, f"stabilize_{policy.label}.rrd")
+        for seed, env, series in applications.rollouts(policy, TASK, seeds, gait, lambda env: record, recording,
+                                                       bar, **task_kwargs):
             per_seed.append({"seed": seed, **metrics(series, settle)})
             first = series if first is None else first
-            if bar is not None:
-                bar.update(1)
         scores = [{k: v for k, v in m.items() if k != "seed"} for m in per_seed]
         report[policy.label] = {"summary": summarize(scores), "goals": goal_check(scores), "seeds": per_seed,
                                 "series": first}
