@@ -2,6 +2,8 @@
 walking quadruped.  Plotting only."""
 from __future__ import annotations
 
+import pathlib
+
 import matplotlib
 
 matplotlib.use("Agg")
