@@ -117,3 +117,32 @@ def test_default_lessons_are_the_domains_curriculum():
     assert sum(l.steps for l in quadruped) == 1000
     with pytest.raises(ValueError, match="has no curriculum"):
         training.plan_from_args(parse(["--domain", "cartpole"]))
+
+
+def test_quadruped_curriculum_resumes_mid_lesson4_exactly(tmp_path):
+    """Killed while the quadruped trots (lesson 4, its trunk height schedule under way), a run
+    restored from its checkpoint continues exactly as the run that was never stopped."""
+    from agents.curriculum import TrainingInterrupted
+    plan = parse_plan("lesson3:40,lesson4:80", default_domain="robostrich_a1")
+    whole = CurriculumRun(plan, TINY, 0, str(tmp_path / "whole"), checkpoint_every=10 ** 6)
+    whole.run()
+    first = CurriculumRun(plan, TINY, 0, str(tmp_path / "killed"), checkpoint_every=10 ** 6)
+    with pytest.raises(TrainingInterrupted):
+        first.run(stop_at_step=90)  # 50 steps into lesson 4
+    assert first.lesson.task == "lesson4" and first.loop.env.task.legs == "walk"
+    first.save_checkpoint()
+    resumed = CurriculumRun(plan, TINY, 0, str(tmp_path / "killed"), checkpoint_every=10 ** 6)
+    resumed.restore()
+    resumed.run()
+    assert resumed.loop.env_steps == whole.loop.env_steps == 120
+    np.testing.assert_array_equal(resumed.loop.env.physics.get_state(), whole.loop.env.physics.get_state())
+    for a, b in zip(jax_leaves(resumed.loop.learner.policy_params), jax_leaves(whole.loop.learner.policy_params),
+                    strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def jax_leaves(tree):
+    import jax
+    leaves = jax.tree_util.tree_leaves(tree)
+    assert leaves
+    return [np.asarray(leaf) for leaf in leaves]
