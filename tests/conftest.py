@@ -1,5 +1,6 @@
 """Shared test set-up: headless MuJoCo (MUJOCO_GL=egl unless the environment sets it), the
-checked-in models, and one way to check Rerun recordings."""
+checked-in models, one way to find an installed console script (``from conftest import
+console_script``) and one way to check Rerun recordings."""
 import os
 import pathlib
 import shutil
@@ -18,6 +19,16 @@ def rerun_cli() -> str | None:
     """The ``rerun`` command of rerun-sdk: beside this Python (an unactivated venv), else on PATH."""
     beside = pathlib.Path(sys.executable).parent / "rerun"
     return str(beside) if beside.exists() else shutil.which("rerun")
+
+
+def console_script(name: str) -> str:
+    """The installed console script ``name``: beside this Python (the venv's), else on PATH; the
+    test skips if it is not installed."""
+    beside = pathlib.Path(sys.executable).parent / name
+    path = str(beside) if beside.exists() else shutil.which(name)
+    if path is None:
+        pytest.skip(f"{name} is not installed (pip install -e .)")
+    return path
 
 
 @pytest.fixture

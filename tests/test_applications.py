@@ -2,9 +2,7 @@
 and the installed commands robostrich-stabilize / robostrich-gap end to end."""
 import json
 import os
-import shutil
 import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -12,24 +10,9 @@ import pytest
 from agents import application_commands, applications, gap, stabilization
 from robostrich_suite.tasks import quadruped_tasks
 
+from conftest import console_script
+
 ENVIRONMENT = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
-
-
-def script(name: str) -> str:
-    path = os.path.join(os.path.dirname(sys.executable), name)
-    path = path if os.path.exists(path) else shutil.which(name)
-    if path is None:
-        pytest.skip(f"{name} is not installed (pip install -e .)")
-    return path
-
-
-def verify_rrd(path) -> None:
-    """`rerun rrd verify` where the rerun command is installed (rerun-sdk ships it)."""
-    cli = os.path.join(os.path.dirname(sys.executable), "rerun")
-    cli = cli if os.path.exists(cli) else shutil.which("rerun")
-    if cli is not None:
-        result = subprocess.run([cli, "rrd", "verify", str(path)], capture_output=True, text=True, timeout=120)
-        assert result.returncode == 0, result.stderr[-2000:]
 
 
 @pytest.fixture(scope="module")
@@ -98,9 +81,9 @@ def test_a_checkpoint_is_evaluated_beside_the_references(tmp_path):
     assert np.isfinite(trained["height_rms_error"])
 
 
-def test_commands_write_reports_figures_and_recordings(tmp_path):
+def test_commands_write_reports_figures_and_recordings(tmp_path, verify_rrd):
     out = tmp_path / "stabilize"
-    done = subprocess.run([script("robostrich-stabilize"), "--seeds", "2", "--time-limit", "1.5", "--settle", "0.5",
+    done = subprocess.run([console_script("robostrich-stabilize"), "--seeds", "2", "--time-limit", "1.5", "--settle", "0.5",
                            "--out", str(out)], capture_output=True, text=True, env=ENVIRONMENT, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     assert "head_stabilize on robostrich_a1" in done.stdout and "lookup" in done.stdout
@@ -109,11 +92,10 @@ def test_commands_write_reports_figures_and_recordings(tmp_path):
     assert len(report["policies"]["lookup"]["seeds"]) == 2
     assert (out / "stabilize_summary.txt").read_text() in done.stdout
     assert (out / "stabilize.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    for label in ("zero", "lookup"):
-        verify_rrd(out / f"stabilize_{label}.rrd")
+    recordings = [out / f"stabilize_{label}.rrd" for label in ("zero", "lookup")]
 
     out = tmp_path / "gap"
-    done = subprocess.run([script("robostrich-gap"), "--seeds", "1", "--time-limit", "0.6", "--steps-per-target", "10",
+    done = subprocess.run([console_script("robostrich-gap"), "--seeds", "1", "--time-limit", "0.6", "--steps-per-target", "10",
                            "--out", str(out), "--no-rerun", "--gait", str(quadruped_tasks.gait_lib.DATA_PATH)],
                           capture_output=True, text=True, env=ENVIRONMENT, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
@@ -121,12 +103,13 @@ def test_commands_write_reports_figures_and_recordings(tmp_path):
     assert report["gait"] == str(quadruped_tasks.gait_lib.DATA_PATH)
     assert len(report["policies"]["lookup"]["summary"]["targets"]) == 6
     assert (out / "gap.png").exists() and not list(out.glob("*.rrd"))
+    verify_rrd(*recordings)  # last: without the rerun command the test skips here (conftest)
 
 
 def test_a_malformed_gait_file_exits_2_with_one_line(tmp_path):
     bad = tmp_path / "gait.csv"
     bad.write_text("time,FR_hip\n0.0,0.1\n")
-    done = subprocess.run([script("robostrich-gap"), "--gait", str(bad), "--out", str(tmp_path / "out")],
+    done = subprocess.run([console_script("robostrich-gap"), "--gait", str(bad), "--out", str(tmp_path / "out")],
                           capture_output=True, text=True, env=ENVIRONMENT, timeout=120)
     assert done.returncode == 2
     lines = done.stderr.strip().splitlines()

@@ -16,18 +16,11 @@ from agents import checkpoint
 from robostrich_suite import targets
 from robostrich_suite.model import layouts
 
+from conftest import console_script
+
 TINY_TRAIN = ["--plan", "lesson1:250", "--no-baseline", "--hidden", "16,16", "--batch-size", "16",
               "--min-replay", "50", "--num-eval-targets", "1", "--final-eval-targets", "1", "--quiet",
               "--no-rerun", "--no-figures"]
-
-
-def script(name: str) -> str:
-    """The console script next to this interpreter (the venv's), else on PATH."""
-    path = os.path.join(os.path.dirname(sys.executable), name)
-    path = path if os.path.exists(path) else shutil.which(name)
-    if path is None:
-        pytest.skip(f"{name} is not installed (pip install -e .)")
-    return path
 
 
 ENVIRONMENT = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
@@ -41,7 +34,7 @@ def shared_jax_cache(tmp_path_factory):
 
 
 def start(name, *args, cwd=None):
-    return subprocess.Popen([script(name), *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    return subprocess.Popen([console_script(name), *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env=ENVIRONMENT, cwd=cwd)
 
 

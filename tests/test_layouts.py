@@ -1,9 +1,7 @@
 """Tendon-layout comparison (issue 13): layout files, the coverage metric, robostrich-layouts."""
 import json
 import os
-import shutil
 import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -11,6 +9,8 @@ import pytest
 from robostrich_suite.model import arm, layouts
 from robostrich_suite.model import fingerprint as fingerprint_lib
 from robostrich_suite.studies import coverage, layout_compare, workspace
+
+from conftest import console_script
 
 
 def xml(layout, spec=None):
@@ -161,17 +161,9 @@ def test_the_better_layout_ships_with_its_own_targets_loadable_through_task_kwar
         layouts.target_file("cranial_every")
 
 
-def script(name):
-    path = os.path.join(os.path.dirname(sys.executable), name)
-    path = path if os.path.exists(path) else shutil.which(name)
-    if path is None:
-        pytest.skip(f"{name} is not installed (pip install -e .)")
-    return path
-
-
 def run_layouts(*args):
     env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
-    return subprocess.run([script("robostrich-layouts"), *map(str, args)], capture_output=True, text=True,
+    return subprocess.run([console_script("robostrich-layouts"), *map(str, args)], capture_output=True, text=True,
                           env=env, timeout=600)
 
 
