@@ -65,6 +65,21 @@ def _write(out: str, name: str, report: dict, series: dict, table: str) -> list:
     return paths
 
 
+def _report(args, name: str, meta: dict, results: dict, series: dict, table: str, policies: list,
+            plot) -> dict:
+    """Write NAME's report, series and table into ``args.out``, the figure (``plot(series as
+    arrays, path)``) unless --no-figures, print the table and every file written (the
+    evaluation already wrote each policy's NAME_LABEL.rrd unless --no-rerun)."""
+    written = _write(args.out, name, {**meta, "policies": results}, series, table)
+    if not args.no_figures:
+        written.append(os.path.join(args.out, f"{name}.png"))
+        plot({k: {"series": {n: np.asarray(v) for n, v in s.items()}} for k, s in series.items()}, written[-1])
+    if not args.no_rerun:
+        written += [os.path.join(args.out, f"{name}_{p.label}.rrd") for p in policies]
+    print(table + "wrote " + ", ".join(written))
+    return {"meta": meta, "policies": results}
+
+
 def _split_series(results: dict) -> tuple:
     """(results without the series, label -> seed-0 series as lists)."""
     series = {label: {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in r["series"].items()}
@@ -123,16 +138,11 @@ def stabilize_main(argv=None) -> dict:
             "goals": {k: {"goal": g, "kind": kind} for k, (g, kind) in stabilization.GOALS.items()}}
     results, series = _split_series(results)
     table = stabilization_table(results, meta)
-    written = _write(args.out, "stabilize", {**meta, "policies": results}, series, table)
-    if not args.no_figures:
-        from agents import application_figures
-        written.append(os.path.join(args.out, "stabilize.png"))
-        application_figures.stabilization_figure({k: {"series": {n: np.asarray(v) for n, v in s.items()}}
-                                                  for k, s in series.items()}, written[-1], args.settle)
-    if not args.no_rerun:
-        written += [os.path.join(args.out, f"stabilize_{p.label}.rrd") for p in policies]
-    print(table + "wrote " + ", ".join(written))
-    return {"meta": meta, "policies": results}
+
+    def plot(arrays, path):
+        from agents import application_figures  # matplotlib only when a figure is drawn
+        application_figures.stabilization_figure(arrays, path, args.settle)
+    return _report(args, "stabilize", meta, results, series, table, policies, plot)
 
 
 def stabilize_cli(argv=None) -> int:
@@ -192,16 +202,11 @@ def gap_main(argv=None) -> dict:
     results, series = _split_series(results)
     meta["episode_s"] = float(next(iter(series.values()))["time"][-1])
     table = gap_table(results, meta)
-    written = _write(args.out, "gap", {**meta, "policies": results}, series, table)
-    if not args.no_figures:
-        from agents import application_figures
-        written.append(os.path.join(args.out, "gap.png"))
-        application_figures.gap_figure({k: {"series": {n: np.asarray(v) for n, v in s.items()}}
-                                        for k, s in series.items()}, gap.scene(), targets, tolerance, written[-1])
-    if not args.no_rerun:
-        written += [os.path.join(args.out, f"gap_{p.label}.rrd") for p in policies]
-    print(table + "wrote " + ", ".join(written))
-    return {"meta": meta, "policies": results}
+
+    def plot(arrays, path):
+        from agents import application_figures  # matplotlib only when a figure is drawn
+        application_figures.gap_figure(arrays, gap.scene(), targets, tolerance, path)
+    return _report(args, "gap", meta, results, series, table, policies, plot)
 
 
 def gap_cli(argv=None) -> int:
