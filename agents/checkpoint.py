@@ -42,6 +42,12 @@ def save(path: str, payload: dict, fingerprint: dict) -> None:
 
 def _read_record(path: str) -> dict:
     """The stored record after checking header, checksum, pickle and format version; CheckpointError if not."""
+    return read_with_digest(path)[0]
+
+
+def read_with_digest(path: str) -> tuple:
+    """(record, hex sha256 of its payload) after the checks of :func:`_read_record`: the digest names
+    this checkpoint's content (``robostrich-train --init-from`` records it)."""
     with open(path, "rb") as f:
         data = f.read()
     if len(data) < len(MAGIC) + 32 or data[:len(MAGIC)] != MAGIC:
@@ -56,7 +62,7 @@ def _read_record(path: str) -> dict:
     if not isinstance(record, dict) or record.get("format_version") != FORMAT_VERSION:
         version = record.get("format_version") if isinstance(record, dict) else None
         raise CheckpointError(f"{path} has format version {version}, expected {FORMAT_VERSION}")
-    return record
+    return record, digest.hex()
 
 
 def load(path: str, fingerprint: dict = None) -> dict:

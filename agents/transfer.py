@@ -188,10 +188,7 @@ class InitSource:
 def _read(path: str):
     if not os.path.isfile(path):
         raise FileNotFoundError(f"--init-from: no checkpoint file {path}")
-    record = checkpoint._read_record(path)  # checks header, checksum and format
-    with open(path, "rb") as f:
-        digest = f.read(len(checkpoint.MAGIC) + 32)[len(checkpoint.MAGIC):].hex()
-    return record, digest
+    return checkpoint.read_with_digest(path)  # checks header, checksum and format
 
 
 def _single_domain(plan, what: str) -> str:
