@@ -116,6 +116,7 @@ class CurriculumRun:
         base = self.domain(self.plan[0])  # a residual policy adds to this domain's (and layout's) lookup
         self.loop = SACBuilder(config).make_components(self._make_lesson_env(0), seed,
                                                        base.lookup_table() if config.residual_scale > 0 else None)
+        self._enter_lesson()
         self.checkpoint_path, self.metrics_path, self.evals_path = run_files(run_dir)
 
     # -- lessons ---------------------------------------------------------------------------
@@ -123,6 +124,10 @@ class CurriculumRun:
         lesson = self.plan[index]
         return self.env_factory(self.domain(lesson), lesson.task, self.seed + 1000 * (index + 1),
                                 **self.task_kwargs)
+
+    def _enter_lesson(self):
+        """What the loop changes with the lesson besides the environment: the hindsight share."""
+        self.loop.her_ratio = self.config.her_ratio_in_lesson(self.lesson_index + 1)
 
     def lesson_checkpoint_path(self, lessons_done: int) -> str:
         """Where ``keep_lesson_checkpoints`` writes the checkpoint after ``lessons_done`` lessons."""
@@ -188,6 +193,7 @@ class CurriculumRun:
             loop.resume_episode(*pickle.loads(zlib.decompress(state["environment"])))
         elif not self.done:
             loop.set_environment(self._make_lesson_env(self.lesson_index), close_episode=False)
+        self._enter_lesson()
         loop.load_state_dict(state["loop"])
         loop.latest_metrics = state.get("latest_metrics", {})
         for p in (self.metrics_path, self.evals_path):  # drop records written after the checkpoint
@@ -233,6 +239,7 @@ class CurriculumRun:
                     self.lesson_steps = 0
                     if not self.done:
                         loop.set_environment(self._make_lesson_env(self.lesson_index))
+                        self._enter_lesson()
                         if self.keep_lesson_checkpoints:
                             self.save_checkpoint(self.lesson_checkpoint_path(self.lesson_index))
                 if on_eval is not None and any(before < s <= loop.env_steps for s in eval_at):

@@ -18,7 +18,8 @@ from agents.replay import ObservationFlattener, ReplayBuffer
 class EnvironmentLoop:
     """Generic over the learner: anything with `step(batches) -> metrics` and `policy_params`; `config` gives
     the loop's schedule (action_repeat, min_replay_size, env_steps_per_call, updates_per_call, batch_size,
-    her_ratio, relabel_rewards), e.g. an agents.sac.SACConfig."""
+    her_ratio, relabel_rewards), e.g. an agents.sac.SACConfig. ``her_ratio`` starts at the config's; a
+    curriculum sets it per lesson (SACConfig.her_lessons)."""
 
     def __init__(self, env, actor: Actor, replay: ReplayBuffer, learner, config,
                  flattener: ObservationFlattener, seed: int = 0, label: str = ""):
@@ -29,6 +30,7 @@ class EnvironmentLoop:
         self.transitions = 0  # agent steps = transitions added to the replay
         self.episodes = 0
         self.warmup_rng = np.random.default_rng(seed + 7919)  # uniform actions before min_replay
+        self.her_ratio = float(getattr(config, "her_ratio", 0.0))
         self.latest_metrics = {}
         self._set_env(env)
 
@@ -108,7 +110,7 @@ class EnvironmentLoop:
             self.transitions += 1
             if self.transitions % cfg.env_steps_per_call == 0 and len(replay) >= cfg.min_replay_size:
                 batches = replay.sample_stack(cfg.updates_per_call, cfg.batch_size, relabeler,
-                                              cfg.her_ratio, cfg.relabel_rewards)
+                                              self.her_ratio, cfg.relabel_rewards)
                 self.latest_metrics = self.learner.step(batches)
                 self.actor.update(self.learner.policy_params)
             if timestep.last():

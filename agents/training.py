@@ -181,12 +181,14 @@ def add_config_arguments(group, defaults: SACConfig = SACConfig()):
 
 def config_from_args(args, argv=None) -> SACConfig:
     values = {f.name: getattr(args, f.name) for f in dataclasses.fields(SACConfig)}
-    values["hidden_sizes"] = tuple(int(h) for h in str(values["hidden_sizes"]).split(",") if h)
+    for field in dataclasses.fields(SACConfig):  # tuple fields come as "64,64"
+        if isinstance(field.default, tuple):
+            values[field.name] = tuple(int(h) for h in str(values[field.name]).split(",") if h.strip())
     if getattr(args, "paper_sac", False):
         explicit = _explicit_fields(argv)
         paper = SACConfig.paper_sac().to_dict()
-        values = {k: (v if k in explicit else paper[k]) for k, v in values.items()}
-        values["hidden_sizes"] = tuple(values["hidden_sizes"])
+        values = {k: (v if k in explicit else paper.get(k, getattr(SACConfig, k))) for k, v in values.items()}
+        values = {k: tuple(v) if isinstance(v, list) else v for k, v in values.items()}
     return SACConfig(**values)
 
 

@@ -1,5 +1,7 @@
 """Hindsight relabelling on the real arm: recomputed rewards are exact, relabelled goals
 come from later in the same episode, and a resumed run with HER is bit-exact."""
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -91,3 +93,32 @@ def test_task_kwargs_reach_every_lesson_and_the_checkpoint_fingerprint(tmp_path)
     assert plain.loop.env.task.weights.position_error == 2.0
     with pytest.raises(ValueError, match="task_kwargs"):
         plain.restore(path)
+
+
+def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path):
+    """her_lessons=(1,): lesson 1's batches get hindsight goals, lesson 2's keep the real
+    targets, and a run resumed in lesson 2 keeps HER off."""
+    plan = parse_plan("robostrich/lesson1:600,robostrich/lesson2:600")
+    config = dataclasses.replace(HER, her_lessons=(1,))
+    run = CurriculumRun(plan, config, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
+    assert run.loop.her_ratio == 0.5
+    with pytest.raises(TrainingInterrupted):
+        run.run(stop_at_step=800)
+    assert run.lesson_index == 1 and run.loop.her_ratio == 0.0
+    replay, relabeler = run.loop.replay, run.loop.relabeler
+    real_targets = {tuple(g) for g in replay.obs[:len(replay), relabeler.goal]}
+
+    def relabelled_share(her_ratio):
+        goals = replay.sample_stack(1, 400, relabeler, her_ratio=her_ratio).obs[0][:, relabeler.goal]
+        return np.mean([tuple(g) not in real_targets for g in goals])
+
+    assert relabelled_share(run.loop.her_ratio) == 0.0
+    assert relabelled_share(config.her_ratio_in_lesson(1)) > 0.3  # what lesson 1 sampled
+    path = str(tmp_path / "ckpt.pkl")
+    run.save_checkpoint(path)
+    resumed = CurriculumRun(plan, config, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
+    assert resumed.loop.her_ratio == 0.5  # lesson 1 until the checkpoint says otherwise
+    resumed.restore(path)
+    assert resumed.loop.her_ratio == 0.0
+    with pytest.raises(ValueError, match="her_lessons"):
+        SACConfig(her_lessons=(0,))
