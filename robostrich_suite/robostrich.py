@@ -15,10 +15,8 @@ desired attitude); ``arm_spec`` and ``tendon_layout`` swap in another arm.
 """
 from __future__ import annotations
 
-from dm_control import mujoco
 from dm_control.utils import containers
 
-from robostrich_suite import physics as physics_lib
 from robostrich_suite import targets as targets_lib
 from robostrich_suite.model import scenes
 from robostrich_suite.tasks import lessons, reach
@@ -37,8 +35,8 @@ def get_model_and_assets(arm_spec=None, tendon_layout=None):
     return model.to_xml_string(precision=XML_PRECISION), {}
 
 
-class Physics(physics_lib.ArmPhysicsMixin, mujoco.Physics):
-    """Physics with the arm's named accessors (see ``ArmPhysicsMixin``)."""
+# The arm on its frame with its accessors: one class for the domain and the studies.
+Physics = scenes.FramePhysics
 
 
 _FACTORY = lessons.LessonFactory(Physics, get_model_and_assets, reach.Reach)
