@@ -106,6 +106,11 @@ class CurriculumRun:
         self.init_from = init_from
         for lesson in plan:  # an unknown layout or a layout on dm_control fails here, not mid-run
             as_domain(lesson.domain, layout)
+        known = {task for lesson in plan for task in as_domain(lesson.domain, layout).tasks()}
+        unknown = sorted(set(config.her_lessons) - known)
+        if unknown:
+            raise ValueError(f"her_lessons names {unknown}, not a task of this plan's domains "
+                             f"(tasks: {', '.join(sorted(known))})")
         self.plan = list(plan)
         self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
         self.checkpoint_every = int(checkpoint_every)
@@ -127,7 +132,7 @@ class CurriculumRun:
 
     def _enter_lesson(self):
         """What the loop changes with the lesson besides the environment: the hindsight share."""
-        self.loop.her_ratio = self.config.her_ratio_in_lesson(self.lesson_index + 1)
+        self.loop.her_ratio = self.config.her_ratio_in_lesson(self.lesson.task)
 
     def lesson_checkpoint_path(self, lessons_done: int) -> str:
         """Where ``keep_lesson_checkpoints`` writes the checkpoint after ``lessons_done`` lessons."""

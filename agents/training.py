@@ -18,6 +18,7 @@ import json
 import os
 import sys
 import time
+import typing
 from collections import deque
 from typing import Optional
 
@@ -181,9 +182,12 @@ def add_config_arguments(group, defaults: SACConfig = SACConfig()):
 
 def config_from_args(args, argv=None) -> SACConfig:
     values = {f.name: getattr(args, f.name) for f in dataclasses.fields(SACConfig)}
-    for field in dataclasses.fields(SACConfig):  # tuple fields come as "64,64"
+    hints = typing.get_type_hints(SACConfig)
+    for field in dataclasses.fields(SACConfig):  # tuple fields come as "64,64" or "lesson1,lesson2"
         if isinstance(field.default, tuple):
-            values[field.name] = tuple(int(h) for h in str(values[field.name]).split(",") if h.strip())
+            item_type = typing.get_args(hints[field.name])[0]
+            values[field.name] = tuple(item_type(item.strip()) for item in str(values[field.name]).split(",")
+                                       if item.strip())
     if getattr(args, "paper_sac", False):
         explicit = _explicit_fields(argv)
         paper = SACConfig.paper_sac().to_dict()

@@ -96,10 +96,10 @@ def test_task_kwargs_reach_every_lesson_and_the_checkpoint_fingerprint(tmp_path)
 
 
 def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path):
-    """her_lessons=(1,): lesson 1's batches get hindsight goals, lesson 2's keep the real
+    """her_lessons=("lesson1",): lesson 1's batches get hindsight goals, lesson 2's keep the real
     targets, and a run resumed in lesson 2 keeps HER off."""
     plan = parse_plan("robostrich/lesson1:600,robostrich/lesson2:600")
-    config = dataclasses.replace(HER, her_lessons=(1,))
+    config = dataclasses.replace(HER, her_lessons=("lesson1",))
     run = CurriculumRun(plan, config, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
     assert run.loop.her_ratio == 0.5
     with pytest.raises(TrainingInterrupted):
@@ -113,7 +113,7 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
         return np.mean([tuple(g) not in real_targets for g in goals])
 
     assert relabelled_share(run.loop.her_ratio) == 0.0
-    assert relabelled_share(config.her_ratio_in_lesson(1)) > 0.3  # what lesson 1 sampled
+    assert relabelled_share(config.her_ratio_in_lesson("lesson1")) > 0.3  # what lesson 1 sampled
     path = str(tmp_path / "ckpt.pkl")
     run.save_checkpoint(path)
     resumed = CurriculumRun(plan, config, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
@@ -121,4 +121,7 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
     resumed.restore(path)
     assert resumed.loop.her_ratio == 0.0
     with pytest.raises(ValueError, match="her_lessons"):
-        SACConfig(her_lessons=(0,))
+        SACConfig(her_lessons="lesson1")  # a string, not a tuple of names
+    with pytest.raises(ValueError, match=r"her_lessons names \['lesson_1'\]"):
+        CurriculumRun(plan, dataclasses.replace(HER, her_lessons=("lesson_1",)), seed=1,
+                      run_dir=str(tmp_path / "c"))

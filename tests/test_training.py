@@ -160,10 +160,10 @@ def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
     assert not config.critic_layer_norm and config.her_ratio == 0 and config.init_temperature == 1.0
     default = training.config_from_args(training.build_parser().parse_args([]), [])
     assert default == SACConfig()  # the CLI's defaults are the dataclass's
-    argv = ["--her-ratio", "0.5", "--her-lessons", "1,2", "--hidden", "32,16"]
+    argv = ["--her-ratio", "0.5", "--her-lessons", "lesson1,lesson2", "--hidden", "32,16"]
     config = training.config_from_args(training.build_parser().parse_args(argv), argv)
-    assert config.her_lessons == (1, 2) and config.hidden_sizes == (32, 16)
-    assert (config.her_ratio_in_lesson(2), config.her_ratio_in_lesson(3)) == (0.5, 0.0)
+    assert config.her_lessons == ("lesson1", "lesson2") and config.hidden_sizes == (32, 16)
+    assert (config.her_ratio_in_lesson("lesson2"), config.her_ratio_in_lesson("lesson3")) == (0.5, 0.0)
 
 
 def test_lesson_checkpoints_hold_the_policy_after_each_lesson(tmp_path):

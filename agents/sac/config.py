@@ -44,10 +44,10 @@ class SACConfig:
     # Off by default: it speeds up lesson 1 (position only) but lowered held-out success of the
     # whole curriculum at 90k steps over 3 seeds (docs/learning.md).
     her_ratio: float = 0.0
-    # The lessons (1-based, in plan order) whose batches get hindsight goals; empty = every lesson.
-    # (1,) relabels only lesson 1, whose eq.-9 reward depends on the head position and the goal
-    # alone; lessons 2-3 also ask for a level head, which relabelled positions rarely had.
-    her_lessons: Tuple[int, ...] = ()
+    # The lesson tasks whose batches get hindsight goals; empty = every task. ("lesson1",) relabels
+    # only lesson 1, whose eq.-9 reward depends on the head position and the goal alone; lessons
+    # 2-3 also ask for a level head, which relabelled positions rarely had (docs/learning.md).
+    her_lessons: Tuple[str, ...] = ()
     # Recompute every sampled transition's reward with the current lesson's reward function
     # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
     # replay then carry lesson-2 rewards instead of the ones they were collected with.
@@ -70,10 +70,9 @@ class SACConfig:
             raise ValueError(f"her_ratio must be in [0, 1], got {self.her_ratio}")
         if not 0.0 <= self.residual_scale <= 2.0:
             raise ValueError(f"residual_scale must be in [0, 2] (0 = no residual), got {self.residual_scale}")
-        her_lessons = tuple(int(n) for n in self.her_lessons)
-        if any(n < 1 for n in her_lessons):
-            raise ValueError(f"her_lessons are 1-based lesson numbers, got {self.her_lessons}")
-        object.__setattr__(self, "her_lessons", her_lessons)
+        if isinstance(self.her_lessons, str) or not all(isinstance(t, str) and t for t in self.her_lessons):
+            raise ValueError(f"her_lessons must be a tuple of task names, e.g. ('lesson1',), got {self.her_lessons!r}")
+        object.__setattr__(self, "her_lessons", tuple(self.her_lessons))
         if self.residual_scale > 0 and self.her_ratio > 0:
             raise ValueError("residual_scale and her_ratio do not mix: a relabelled goal changes the lookup's "
                              "base action, so the stored residual would no longer mean what it did")
@@ -87,9 +86,9 @@ class SACConfig:
     def update_to_data_ratio(self) -> float:
         return self.updates_per_call / self.env_steps_per_call
 
-    def her_ratio_in_lesson(self, lesson_number: int) -> float:
-        """The hindsight share of the batches in lesson ``lesson_number`` (1-based)."""
-        return self.her_ratio if not self.her_lessons or lesson_number in self.her_lessons else 0.0
+    def her_ratio_in_lesson(self, task: str) -> float:
+        """The hindsight share of the batches while training on ``task`` (e.g. "lesson1")."""
+        return self.her_ratio if not self.her_lessons or task in self.her_lessons else 0.0
 
     def resolved_target_entropy(self, action_size: int) -> float:
         return -float(action_size) if self.target_entropy is None else float(self.target_entropy)
