@@ -218,3 +218,74 @@ def track_figure(reports: Dict[str, dict]):
 def plot_track(reports: Dict[str, dict], path: str):
     """Write :func:`track_figure` to ``path`` (PNG)."""
     _save(track_figure(reports), path)
+
+
+def seed_groups_figure(groups: Dict[str, List[dict]], lookup: Dict[str, float] = None,
+                       lesson_boundaries=None):
+    """Training configurations compared over seeds, the way docs/learning.md reads them:
+    (a) periodic held-out success and (b) held-out median position error along training (mean
+    over seeds, the min-max band shaded), (c) the final held-out success of every seed, from the
+    fixed start and from moving starts.
+
+    ``groups``: label -> one dict per seed, ``{"seed": int, "evals": [evals.jsonl records],
+    "final": {kind: summary}}`` (kind ``heldout`` and optionally ``heldout_moving``);
+    ``lookup``: kind -> the lookup's final success rate, drawn dashed (the bar to clear).
+    """
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), gridspec_kw={"width_ratios": [1.2, 1.2, 1.0]})
+    last_step = 0
+    for index, (label, seeds) in enumerate(groups.items()):
+        color = f"C{index}"
+        curves = [s["evals"] for s in seeds if s["evals"]]
+        if curves:
+            length = min(len(c) for c in curves)  # the steps every seed has reached
+            steps = np.array([r["env_steps"] for r in curves[0][:length]])
+            last_step = max(last_step, int(steps[-1]))
+            for ax, metric in ((axes[0], "success_rate"), (axes[1], "position_error_median")):
+                values = np.array([[r["summary"][metric] for r in c[:length]] for c in curves])
+                ax.plot(steps, values.mean(axis=0), "o-", color=color, ms=3,
+                        label=f"{label} (mean of {len(curves)} seeds)")
+                ax.fill_between(steps, values.min(axis=0), values.max(axis=0), color=color, alpha=0.15)
+        for offset, (kind, marker) in enumerate((("heldout", "o"), ("heldout_moving", "^"))):
+            rates = [(s["seed"], s["final"][kind]["success_rate"]) for s in seeds if kind in s.get("final", {})]
+            if not rates:
+                continue
+            x = index + (offset - 0.5) * 0.3
+            axes[2].scatter([x] * len(rates), [r for _, r in rates], color=color, marker=marker,
+                            label="fixed start" if index == 0 and kind == "heldout" else
+                            ("moving starts" if index == 0 else None), zorder=3)
+            for seed, rate in rates:
+                axes[2].annotate(str(seed), (x, rate), xytext=(4, 0), textcoords="offset points",
+                                 fontsize=7, va="center", color="0.3")
+            mean = float(np.mean([r for _, r in rates]))
+            axes[2].plot([x - 0.1, x + 0.1], [mean, mean], color=color, lw=2)
+    for kind, style in (("heldout", "--"), ("heldout_moving", ":")):
+        if lookup and kind in lookup:
+            where = "fixed start" if kind == "heldout" else "moving starts"
+            axes[2].axhline(lookup[kind], color="k", ls=style, lw=1, label=f"lookup, {where}")
+            if kind == "heldout":
+                axes[0].axhline(lookup[kind], color="k", ls=style, lw=1, label="lookup (all held-out targets)")
+    axes[0].set_ylim(*SUCCESS_LIMITS)
+    axes[2].set_ylim(*SUCCESS_LIMITS)
+    axes[1].set_yscale("log")
+    axes[1].axhline(0.01, color="k", lw=0.8, ls=":", label="1 cm goal")
+    boundaries = list(lesson_boundaries or [])
+    _mark_lessons(axes[:2], boundaries, [f"lesson {i + 1}" for i in range(len(boundaries) + 1)]
+                  if boundaries else [], last_step)
+    for ax in axes[:2]:
+        ax.set_xlabel("environment steps")
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(3, 3))
+    axes[2].set_xticks(range(len(groups)))
+    axes[2].set_xticklabels(list(groups), fontsize=8)
+    axes[2].set_xlim(-0.6, len(groups) - 0.4)
+    for ax, where in zip(axes, ("lower right", "lower left", "lower right")):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc=where)
+    axes[0].set_title("(a) periodic held-out success (spread targets)", fontsize=10)
+    axes[0].set_ylabel("success rate")
+    axes[1].set_title("(b) periodic held-out median position error", fontsize=10)
+    axes[1].set_ylabel("position error (m)")
+    axes[2].set_title("(c) final held-out success per seed (bar: mean)", fontsize=10)
+    axes[2].set_ylabel("success rate")
+    fig.suptitle("Configurations over seeds: mean line, min-max band", fontsize=11)
+    fig.tight_layout()
+    return fig

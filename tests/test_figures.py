@@ -2,6 +2,10 @@
 (no pixels): titles and panel letters, labels of every reference line and band, a
 colourbar where colour means time, nothing hidden under a legend, and a success
 rate on its whole [0, 1] range.  The data come from short real simulations."""
+import pathlib
+import subprocess
+import sys
+
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
@@ -165,3 +169,41 @@ def test_track_figure_numbers_the_targets_and_labels_tolerances(passive_arm_repo
         assert "next target" in _legend_labels(fig.axes[1])
     finally:
         plt.close(fig)
+
+
+def _seed_run(seed, curve, final, moving):
+    """What compare_runs reads from one robostrich-train directory (numbers chosen so the
+    means and bands are known exactly)."""
+    evals = [{"env_steps": 1000 * (i + 1), "summary": {"success_rate": s, "position_error_median": 0.05 - 0.01 * s}}
+             for i, s in enumerate(curve)]
+    return {"seed": seed, "evals": evals, "final": {"heldout": {"success_rate": final},
+                                                    "heldout_moving": {"success_rate": moving}}}
+
+
+def test_seed_groups_figure_draws_the_mean_the_seed_band_and_every_seeds_final_rate():
+    groups = {"A": [_seed_run(0, [0.2, 0.6, 1.0], 0.9, 0.8), _seed_run(1, [0.0, 0.4, 0.8, 0.9], 0.5, 0.4)],
+              "B": [_seed_run(3, [0.5, 0.5, 0.5], 1.0, 1.0)]}
+    fig = figures.seed_groups_figure(groups, lookup={"heldout": 0.95, "heldout_moving": 0.7},
+                                     lesson_boundaries=[2000])
+    success, error, finals = fig.axes[:3]
+    mean_a = _line(success, "A (mean of 2 seeds)")
+    np.testing.assert_allclose(mean_a.get_xdata(), [1000, 2000, 3000])  # the steps both seeds reached
+    np.testing.assert_allclose(mean_a.get_ydata(), [0.1, 0.5, 0.9])
+    band = success.collections[0].get_paths()[0].vertices[:, 1]
+    assert band.min() == pytest.approx(0.0) and band.max() == pytest.approx(1.0)  # seed min..max
+    assert _line(error, "A (mean of 2 seeds)").get_ydata()[0] == pytest.approx(0.049)
+    assert _line(finals, "lookup, fixed start").get_ydata()[0] == 0.95
+    rates = sorted(float(y) for c in finals.collections for y in c.get_offsets()[:, 1])
+    assert rates == [0.4, 0.5, 0.8, 0.9, 1.0, 1.0]  # every seed, fixed and moving starts
+    assert [t.get_text() for t in finals.get_xticklabels()] == ["A", "B"]
+    assert finals.get_ylim()[0] < 0 < 1 < finals.get_ylim()[1]
+    plt.close(fig)
+
+
+def test_compare_runs_says_which_directory_is_not_a_run(tmp_path):
+    tool = pathlib.Path(__file__).parents[1] / "tools" / "compare_runs.py"
+    (tmp_path / "s0").mkdir()
+    result = subprocess.run([sys.executable, str(tool), "--out", str(tmp_path / "x.png"), f"A={tmp_path}/s*"],
+                            capture_output=True, text=True)
+    assert result.returncode != 0 and "is not a finished robostrich-train run" in result.stderr
+    assert not (tmp_path / "x.png").exists()

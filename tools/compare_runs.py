@@ -1,0 +1,80 @@
+"""Compare training configurations over seeds in one figure (docs/learning.md's pictures).
+
+    python tools/compare_runs.py --out docs/her_lesson1.png \
+        "eq. 10 + precision=runs/P1_s*" "+ HER in lesson 1=runs/P1_H1_s*"
+
+Each GROUP is ``LABEL=GLOB``: the glob names robostrich-train output directories (one per seed;
+their curriculum/evals.jsonl, config.json and summary.json are read). Writes a PNG (periodic
+held-out success and position error along training, final success per seed, the lookup's level
+dashed) and prints each group's final held-out numbers, mean [min, max] over its seeds.
+"""
+import argparse
+import glob
+import json
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+from agents import figures  # noqa: E402
+from agents.curriculum import parse_plan  # noqa: E402
+
+KINDS = ("heldout", "heldout_moving")
+
+
+def load_run(run_dir: str) -> dict:
+    """One seed's periodic and final evaluations (the curriculum run of a robostrich-train directory)."""
+    try:
+        with open(os.path.join(run_dir, "config.json")) as f:
+            config = json.load(f)
+        with open(os.path.join(run_dir, "summary.json")) as f:
+            runs = json.load(f)["runs"]
+        with open(os.path.join(run_dir, "curriculum", "evals.jsonl")) as f:
+            evals = [json.loads(line) for line in f if line.strip()]
+    except (OSError, ValueError, KeyError) as e:
+        raise SystemExit(f"compare_runs: error: {run_dir} is not a finished robostrich-train run ({e})")
+    return {"seed": int(config["seed"]), "evals": evals, "plan": config["plans"]["curriculum"],
+            "final": {k: runs["curriculum"][k] for k in KINDS if k in runs["curriculum"]},
+            "lookup": {k: runs["lookup"][k]["success_rate"] for k in KINDS if k in runs.get("lookup", {})}}
+
+
+def parse_group(text: str):
+    label, sep, pattern = text.partition("=")
+    if not sep or not label or not pattern:
+        raise argparse.ArgumentTypeError(f"a group is LABEL=GLOB, got {text!r}")
+    dirs = sorted(glob.glob(pattern))
+    if not dirs:
+        raise argparse.ArgumentTypeError(f"no run directory matches {pattern!r}")
+    return label, dirs
+
+
+def _stat(values, scale=1.0, fmt="{:.1f}"):
+    values = [scale * v for v in values]
+    return f"{fmt.format(sum(values) / len(values))} [{fmt.format(min(values))}, {fmt.format(max(values))}]"
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("groups", nargs="+", type=parse_group, metavar="LABEL=GLOB")
+    parser.add_argument("--out", required=True, help="PNG to write")
+    args = parser.parse_args(argv)
+    groups = {label: [load_run(d) for d in dirs] for label, dirs in args.groups}
+    runs = [run for seeds in groups.values() for run in seeds]
+    lookup = next((r["lookup"] for r in runs if r["lookup"]), None)
+    plan = parse_plan(runs[0]["plan"])
+    boundaries = [sum(l.steps for l in plan[:i + 1]) for i in range(len(plan) - 1)]
+    figures._save(figures.seed_groups_figure(groups, lookup, boundaries), args.out)
+    for label, seeds in groups.items():
+        line = [f"{label} ({len(seeds)} seeds: {', '.join(str(s['seed']) for s in seeds)}):"]
+        for kind in KINDS:
+            finals = [s["final"][kind] for s in seeds if kind in s["final"]]
+            if finals:
+                line.append(f"  {kind}: success {_stat([f['success_rate'] for f in finals], 100)} %, "
+                            f"median {_stat([f['position_error_median'] for f in finals], 100, '{:.2f}')} cm, "
+                            f"{_stat([f['attitude_error_median'] for f in finals], 1, '{:.2f}')} deg")
+        print("\n".join(line))
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
