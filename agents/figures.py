@@ -3,6 +3,7 @@
 ``learning_curves_figure`` and ``track_figure`` return the Figure (so tests can read
 what a reader sees); ``plot_learning_curves`` and ``plot_track`` write it as a PNG.
 """
+import textwrap
 from typing import Dict, List
 
 import matplotlib
@@ -275,11 +276,16 @@ def seed_groups_figure(groups: Dict[str, List[dict]], lookup: Dict[str, float] =
         ax.set_xlabel("environment steps")
         ax.ticklabel_format(axis="x", style="sci", scilimits=(3, 3))
     axes[2].set_xticks(range(len(groups)))
-    axes[2].set_xticklabels(list(groups), fontsize=8)
+    axes[2].set_xticklabels([textwrap.fill(label, 12) for label in groups], fontsize=8)
     axes[2].set_xlim(-0.6, len(groups) - 0.4)
-    for ax, where in zip(axes, ("lower right", "lower left", "lower right")):
+    for ax in axes:
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc=where)
+    # (a) and (b) share their lines: one legend under both, off the data; (c) keeps its markers'.
+    handles, labels = axes[0].get_legend_handles_labels()
+    extra = [(h, l) for h, l in zip(*axes[1].get_legend_handles_labels()) if l not in labels]
+    fig.legend(handles + [h for h, _ in extra], labels + [l for _, l in extra], loc="lower center",
+               ncol=min(4, len(labels) + len(extra)), fontsize=8, frameon=False)
+    axes[2].legend(fontsize=7, loc="lower left")
     axes[0].set_title("(a) periodic held-out success (spread targets)", fontsize=10)
     axes[0].set_ylabel("success rate")
     axes[1].set_title("(b) periodic held-out median position error", fontsize=10)
@@ -287,5 +293,6 @@ def seed_groups_figure(groups: Dict[str, List[dict]], lookup: Dict[str, float] =
     axes[2].set_title("(c) final held-out success per seed (bar: mean)", fontsize=10)
     axes[2].set_ylabel("success rate")
     fig.suptitle("Configurations over seeds: mean line, min-max band", fontsize=11)
-    fig.tight_layout()
+    legend_rows = -(-(len(labels) + len(extra)) // 4)
+    fig.tight_layout(rect=(0, 0.04 + 0.045 * legend_rows, 1, 1))
     return fig

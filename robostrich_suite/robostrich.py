@@ -15,6 +15,8 @@ desired attitude); ``arm_spec`` and ``tendon_layout`` swap in another arm.
 """
 from __future__ import annotations
 
+import collections.abc  # noqa: F401  dm_control.utils.containers uses it without importing it
+
 from dm_control.utils import containers
 
 from robostrich_suite import targets as targets_lib
