@@ -106,11 +106,12 @@ class CurriculumRun:
         self.init_from = init_from
         for lesson in plan:  # an unknown layout or a layout on dm_control fails here, not mid-run
             as_domain(lesson.domain, layout)
-        known = {task for lesson in plan for task in as_domain(lesson.domain, layout).tasks()}
-        unknown = sorted(set(config.her_lessons) - known)
-        if unknown:
-            raise ValueError(f"her_lessons names {unknown}, not a task of this plan's domains "
-                             f"(tasks: {', '.join(sorted(known))})")
+        if config.her_lessons:  # a misspelt lesson would silently turn hindsight goals off
+            known = {task for lesson in plan for task in as_domain(lesson.domain, layout).tasks()}
+            unknown = sorted(set(config.her_lessons) - known)
+            if unknown:
+                raise ValueError(f"her_lessons names {unknown}, not a task of this plan's domains "
+                                 f"(tasks: {', '.join(sorted(known))})")
         self.plan = list(plan)
         self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
         self.checkpoint_every = int(checkpoint_every)

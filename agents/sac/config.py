@@ -73,6 +73,9 @@ class SACConfig:
         if isinstance(self.her_lessons, str) or not all(isinstance(t, str) and t for t in self.her_lessons):
             raise ValueError(f"her_lessons must be a tuple of task names, e.g. ('lesson1',), got {self.her_lessons!r}")
         object.__setattr__(self, "her_lessons", tuple(self.her_lessons))
+        if self.her_lessons and self.her_ratio == 0:
+            raise ValueError(f"her_lessons {self.her_lessons} names lessons for hindsight goals, but her_ratio "
+                             "is 0: give it a share too (e.g. her_ratio=0.5)")
         if self.residual_scale > 0 and self.her_ratio > 0:
             raise ValueError("residual_scale and her_ratio do not mix: a relabelled goal changes the lookup's "
                              "base action, so the stored residual would no longer mean what it did")
