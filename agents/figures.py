@@ -1,7 +1,8 @@
 """PNG figures in the manner of the paper's Fig. 7 (matplotlib, Agg backend: no display needed).
 
-``learning_curves_figure`` and ``track_figure`` return the Figure (so tests can read
-what a reader sees); ``plot_learning_curves`` and ``plot_track`` write it as a PNG.
+``learning_curves_figure``, ``track_figure`` and ``seed_groups_figure`` return the Figure (so
+tests can read what a reader sees); ``plot_learning_curves``, ``plot_track`` and
+``plot_seed_groups`` write it as a PNG.
 """
 import textwrap
 from typing import Dict, List
@@ -296,3 +297,9 @@ def seed_groups_figure(groups: Dict[str, List[dict]], lookup: Dict[str, float] =
     legend_rows = -(-(len(labels) + len(extra)) // 4)
     fig.tight_layout(rect=(0, 0.04 + 0.045 * legend_rows, 1, 1))
     return fig
+
+
+def plot_seed_groups(groups: Dict[str, List[dict]], path: str, lookup: Dict[str, float] = None,
+                     lesson_boundaries=None):
+    """Write :func:`seed_groups_figure` to ``path`` (PNG)."""
+    _save(seed_groups_figure(groups, lookup, lesson_boundaries), path)

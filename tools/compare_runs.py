@@ -6,7 +6,8 @@
 Each GROUP is ``LABEL=GLOB``: the glob names robostrich-train output directories (one per seed;
 their curriculum/evals.jsonl, config.json and summary.json are read). Writes a PNG (periodic
 held-out success and position error along training, final success per seed, the lookup's level
-dashed) and prints each group's final held-out numbers, mean [min, max] over its seeds.
+dashed) and prints each group's final numbers as tools/benchmark_seeds.py tabulates them (mean
+[min, max] over its seeds).
 """
 import argparse
 import glob
@@ -14,8 +15,11 @@ import json
 import os
 import sys
 
+import numpy as np
+
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
+import benchmark_seeds  # noqa: E402  (tools/, beside this script)
 from agents import figures  # noqa: E402
 from agents.curriculum import parse_plan  # noqa: E402
 
@@ -28,14 +32,16 @@ def load_run(run_dir: str) -> dict:
         with open(os.path.join(run_dir, "config.json")) as f:
             config = json.load(f)
         with open(os.path.join(run_dir, "summary.json")) as f:
-            runs = json.load(f)["runs"]
+            summary = json.load(f)
+        runs = summary["runs"]
         with open(os.path.join(run_dir, "curriculum", "evals.jsonl")) as f:
             evals = [json.loads(line) for line in f if line.strip()]
+        return {"seed": int(config["seed"]), "evals": evals, "plan": config["plans"]["curriculum"],
+                "summary": summary, "minutes": benchmark_seeds.seed_minutes(run_dir, summary),
+                "final": {k: runs["curriculum"][k] for k in KINDS if k in runs["curriculum"]},
+                "lookup": {k: runs["lookup"][k]["success_rate"] for k in KINDS if k in runs.get("lookup", {})}}
     except (OSError, ValueError, KeyError) as e:
         raise SystemExit(f"compare_runs: error: {run_dir} is not a finished robostrich-train run ({e})")
-    return {"seed": int(config["seed"]), "evals": evals, "plan": config["plans"]["curriculum"],
-            "final": {k: runs["curriculum"][k] for k in KINDS if k in runs["curriculum"]},
-            "lookup": {k: runs["lookup"][k]["success_rate"] for k in KINDS if k in runs.get("lookup", {})}}
 
 
 def parse_group(text: str):
@@ -48,11 +54,6 @@ def parse_group(text: str):
     return label, dirs
 
 
-def _stat(values, scale=1.0, fmt="{:.1f}"):
-    values = [scale * v for v in values]
-    return f"{fmt.format(sum(values) / len(values))} [{fmt.format(min(values))}, {fmt.format(max(values))}]"
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("groups", nargs="+", type=parse_group, metavar="LABEL=GLOB")
@@ -61,18 +62,12 @@ def main(argv=None):
     groups = {label: [load_run(d) for d in dirs] for label, dirs in args.groups}
     runs = [run for seeds in groups.values() for run in seeds]
     lookup = next((r["lookup"] for r in runs if r["lookup"]), None)
-    plan = parse_plan(runs[0]["plan"])
-    boundaries = [sum(l.steps for l in plan[:i + 1]) for i in range(len(plan) - 1)]
-    figures._save(figures.seed_groups_figure(groups, lookup, boundaries), args.out)
+    boundaries = np.cumsum([lesson.steps for lesson in parse_plan(runs[0]["plan"])])[:-1]
+    figures.plot_seed_groups(groups, args.out, lookup, list(boundaries))
     for label, seeds in groups.items():
-        line = [f"{label} ({len(seeds)} seeds: {', '.join(str(s['seed']) for s in seeds)}):"]
-        for kind in KINDS:
-            finals = [s["final"][kind] for s in seeds if kind in s["final"]]
-            if finals:
-                line.append(f"  {kind}: success {_stat([f['success_rate'] for f in finals], 100)} %, "
-                            f"median {_stat([f['position_error_median'] for f in finals], 100, '{:.2f}')} cm, "
-                            f"{_stat([f['attitude_error_median'] for f in finals], 1, '{:.2f}')} deg")
-        print("\n".join(line))
+        print(f"## {label}\n")
+        print(benchmark_seeds.format_table(benchmark_seeds.aggregate(
+            [s["summary"] for s in seeds], [s["seed"] for s in seeds], [s["minutes"] for s in seeds])))
     print(f"wrote {args.out}")
 
 
