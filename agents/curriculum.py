@@ -106,8 +106,10 @@ class CurriculumRun:
         self.init_from = init_from
         for lesson in plan:  # an unknown layout or a layout on dm_control fails here, not mid-run
             as_domain(lesson.domain, layout)
-        if config.her_lessons:  # a misspelt lesson would silently turn hindsight goals off
-            known = {task for lesson in plan for task in as_domain(lesson.domain, layout).tasks()}
+        arm_plan = [lesson for lesson in plan if as_domain(lesson.domain, layout).is_arm]
+        if config.her_ratio > 0 and config.her_lessons and arm_plan:  # a misspelt lesson would silently
+            # turn hindsight goals off (dm_control's tasks have no goal reward: HER does not apply there)
+            known = {task for lesson in arm_plan for task in as_domain(lesson.domain, layout).tasks()}
             unknown = sorted(set(config.her_lessons) - known)
             if unknown:
                 raise ValueError(f"her_lessons names {unknown}, not a task of this plan's domains "

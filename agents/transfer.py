@@ -215,7 +215,8 @@ def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = Non
     correspondence(source_domain, target_domain)
     if fingerprint.get("layout") != layout:
         raise TransferError(f"--init-from: {path} was trained with tendon layout "
-                            f"{fingerprint.get('layout') or 'the paper'!r}, this run uses {layout or 'the paper'!r}")
+                            f"{fingerprint.get('layout') or 'paper'!r}, this run uses {layout or 'paper'!r} "
+                            f"(pass --layout {fingerprint.get('layout') or 'paper'})")
     for field in NETWORK_FIELDS:  # read from the dict: another run's config may have other fields
         a, b = fingerprint["config"].get(field, getattr(SACConfig(), field)), getattr(config, field)
         a = tuple(a) if isinstance(a, list) else a

@@ -122,8 +122,9 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
     assert resumed.loop.her_ratio == 0.0
     with pytest.raises(ValueError, match="her_lessons"):
         SACConfig(her_ratio=0.5, her_lessons="lesson1")  # a string, not a tuple of names
-    with pytest.raises(ValueError, match="her_ratio is 0"):
-        SACConfig(her_lessons=("lesson1",))  # the lessons named, no share given
+    off = CurriculumRun(plan, dataclasses.replace(HER, her_ratio=0.0, her_lessons=("lesson_1",)), seed=1,
+                        run_dir=str(tmp_path / "off"))  # --her-ratio 0 turns HER off whatever the lessons say
+    assert off.loop.her_ratio == 0.0
     with pytest.raises(ValueError, match=r"her_lessons names \['lesson_1'\]"):
         CurriculumRun(plan, dataclasses.replace(HER, her_lessons=("lesson_1",)), seed=1,
                       run_dir=str(tmp_path / "c"))

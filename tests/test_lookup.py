@@ -128,7 +128,7 @@ def test_residual_adapter_offsets_the_lookup_by_a_bounded_correction(flattener):
 def test_untrained_residual_agent_is_the_lookup(flattener, tmp_path):
     """The policy's mean head starts at zero, so before any update the residual agent's
     deterministic action is the lookup's and it lands where the lookup lands."""
-    config = SACConfig(residual_scale=0.25, min_replay_size=10)
+    config = SACConfig(residual_scale=0.25, min_replay_size=10, her_ratio=0.0)
     run = CurriculumRun(parse_plan("lesson2:100"), config, seed=0, run_dir=str(tmp_path / "run"))
     actor = SACBuilder.make_eval_actor(run.loop)
     target = targets.heldout_targets()[:2]

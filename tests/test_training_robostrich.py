@@ -66,8 +66,12 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
     evals = [json.loads(l) for l in open(os.path.join(out, "curriculum", "evals.jsonl"))]
     assert [e["env_steps"] for e in evals] == [125, 250, 375, 500, 625, 750]
     # the baseline has the same total budget, on the final lesson alone
-    baseline = json.load(open(os.path.join(out, "config.json")))["plans"]["baseline"]
-    assert baseline == "robostrich/lesson3:750"
+    recorded = json.load(open(os.path.join(out, "config.json")))
+    assert recorded["plans"]["baseline"] == "robostrich/lesson3:750"
+    # the main job's defaults on the arm: the layout it learns and the precision term (docs/learning.md)
+    assert recorded["layout"] == "antagonist_pairs"
+    assert recorded["task_kwargs"] == {"weights": {"position_precision": 1.0}}
+    assert recorded["config"]["her_lessons"] == ["lesson1"] and recorded["config"]["her_ratio"] == 0.5
     reports = evaluation.main([os.path.join(out, "curriculum", "checkpoint.pkl"), "--out", str(tmp_path / "ev"),
                                "--num-targets", "2", "--no-rerun", "--label", "curriculum"])
     for label in ("curriculum", "lookup"):  # deterministic policies, same targets

@@ -56,6 +56,10 @@ def build_parser():
     g.add_argument("--updates-per-call", type=int, default=8)
     g.add_argument("--env-steps-per-call", type=int, default=8, help="agent steps (transitions) between learner calls")
     g.add_argument("--min-replay", type=int, default=5000, help="transitions (agent steps) of uniform actions first")
+    g.add_argument("--init-temperature", type=float, default=0.01,
+                   help="initial entropy temperature (Acme: 1; default: the arm agent's %(default)s)")
+    g.add_argument("--target-entropy-per-action", type=float, default=-1.0,
+                   help="target entropy per action dimension (default: Acme's %(default)s)")
     return p
 
 
@@ -170,7 +174,9 @@ def main(argv=None) -> int:
                                 hidden_sizes=tuple(int(h) for h in args.hidden.split(",") if h),
                                 min_replay_size=args.min_replay, updates_per_call=args.updates_per_call,
                                 env_steps_per_call=args.env_steps_per_call, action_repeat=settings[t][1],
-                                critic_layer_norm=args.critic_layer_norm) for t in tasks}
+                                critic_layer_norm=args.critic_layer_norm, init_temperature=args.init_temperature,
+                                target_entropy_per_action=args.target_entropy_per_action,
+                                her_ratio=0.0, her_lessons=()) for t in tasks}
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
