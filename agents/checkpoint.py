@@ -65,11 +65,13 @@ def read_with_digest(path: str) -> tuple:
     return record, digest.hex()
 
 
-def load(path: str, fingerprint: dict = None) -> dict:
-    """Returns the payload; raises CheckpointError if damaged or if `fingerprint` differs."""
+def load(path: str, fingerprint: dict = None, upgrade=None) -> dict:
+    """Returns the payload; raises CheckpointError if damaged or if `fingerprint` differs from the
+    stored one (passed through `upgrade` first, e.g. to fill in fields older checkpoints lack)."""
     record = _read_record(path)
     if fingerprint is not None:
-        check_fingerprint(record["fingerprint"], fingerprint, path)
+        stored = record["fingerprint"] if upgrade is None else upgrade(record["fingerprint"])
+        check_fingerprint(stored, fingerprint, path)
     return record["payload"]
 
 

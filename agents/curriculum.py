@@ -63,6 +63,18 @@ def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, task_kwar
     return identity
 
 
+def upgrade_fingerprint(fingerprint: dict) -> dict:
+    """A stored fingerprint with the config fields its checkpoint predates filled in as its run had
+    them (`SACConfig.LEGACY_VALUES`), to compare with a fingerprint of today's code."""
+    if not isinstance(fingerprint.get("config"), dict):
+        return fingerprint
+    try:
+        config = SACConfig.from_dict(fingerprint["config"]).to_dict()
+    except (TypeError, ValueError):
+        return fingerprint  # another program's config: the comparison names what differs
+    return {**fingerprint, "config": config}
+
+
 def make_environment(domain, task: str, seed: int, **task_kwargs):
     """robostrich_suite.load for the arm domains, dm_control.suite.load otherwise (agents/domains.py);
     `domain` is a name or an agents.domains.Domain (which may carry a tendon layout)."""
@@ -190,7 +202,7 @@ class CurriculumRun:
 
     def restore(self, path: Optional[str] = None):
         path = path or self.checkpoint_path
-        state = checkpoint.load(path, self.fingerprint())
+        state = checkpoint.load(path, self.fingerprint(), upgrade=upgrade_fingerprint)
         loop = self.loop
         loop.learner.set_state(state["learner"])
         loop.actor.update(loop.learner.policy_params)

@@ -25,7 +25,8 @@ from typing import Optional
 import numpy as np
 
 from agents import evaluation
-from agents.curriculum import CurriculumRun, Lesson, format_plan, parse_plan, run_files, run_identity
+from agents.curriculum import (CurriculumRun, Lesson, format_plan, parse_plan, run_files, run_identity,
+                               upgrade_fingerprint)
 from agents.domains import Domain
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
@@ -467,7 +468,7 @@ def main(argv=None):
         from agents import checkpoint
         for label in existing:
             path = os.path.join(args.out, label, "checkpoint.pkl")
-            stored = checkpoint.read_fingerprint(path)
+            stored = upgrade_fingerprint(checkpoint.read_fingerprint(path))
             if label == "curriculum":  # a started run's learner is in its checkpoint: --init-from may be left out
                 if init and stored.get("init_from") != init["init_digest"]:
                     raise ValueError(f"{path} did not start from --init-from {args.init_from} "

@@ -98,6 +98,29 @@ def test_mismatched_or_damaged_checkpoint_raises(tmp_path):
         d.restore(damaged)
 
 
+def test_checkpoint_from_before_a_config_field_loads_as_its_run_had_it(tmp_path):
+    """A fingerprint without her_lessons and target_entropy_per_action (written before they
+    existed) means every-lesson HER and Acme's -1 per action: it loads and resumes under those
+    settings (robostrich-evaluate, --resume) and is refused under today's defaults."""
+    from agents import evaluation
+    plan = parse_plan("point_mass/easy:300")
+    legacy = SACConfig(**{**TINY.to_dict(), "hidden_sizes": (32, 32), "her_lessons": (),
+                          "target_entropy_per_action": -1.0})
+    run = CurriculumRun(plan, legacy, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300)
+    run.run()
+    payload = checkpoint.load(run.checkpoint_path)
+    old = run.fingerprint()
+    old["config"] = {k: v for k, v in old["config"].items() if k not in ("her_lessons", "target_entropy_per_action")}
+    path = str(tmp_path / "old.pkl")
+    checkpoint.save(path, payload, old)
+    loaded = evaluation.load_run_from_checkpoint(path)
+    assert loaded.config == legacy and loaded.config.resolved_target_entropy(2) == -2.0  # point_mass: |A| = 2
+    assert_same_run(loaded, run)
+    today = SACConfig(**{**TINY.to_dict(), "hidden_sizes": (32, 32)})  # -2 per action
+    with pytest.raises(ValueError, match=r"target_entropy_per_action: checkpoint has -1.0, this run has -2.0"):
+        CurriculumRun(plan, today, seed=0, run_dir=str(tmp_path / "b")).restore(path)
+
+
 def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
     plan = parse_plan("point_mass/easy:500,point_mass/hard:500")
     run = CurriculumRun(plan, TINY, seed=2, run_dir=str(tmp_path), checkpoint_every=10_000)

@@ -1,6 +1,6 @@
 """Hyperparameters of the SAC agent: the main job's defaults; `SACConfig.paper_sac()` gives Acme's plain SAC."""
 import dataclasses
-from typing import Optional, Tuple
+from typing import ClassVar, Optional, Tuple
 
 import numpy as np
 
@@ -65,6 +65,10 @@ class SACConfig:
     # clearly prefers a correction (0 = off, plain SAC's actor loss; 0.4 is TD3+BC's alpha = 2.5).
     action_anchor: float = 0.0
 
+    # What a field was, in effect, for checkpoints written before it existed: their fingerprints
+    # lack it, and `from_dict` fills it in so that they still load, resume and compare equal.
+    LEGACY_VALUES: ClassVar[dict] = {"her_lessons": (), "target_entropy_per_action": -1.0}
+
     def __post_init__(self):
         if min(self.batch_size, self.updates_per_call, self.env_steps_per_call, self.action_repeat) <= 0:
             raise ValueError("batch_size, updates_per_call, env_steps_per_call and action_repeat must be positive")
@@ -105,10 +109,7 @@ class SACConfig:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d["hidden_sizes"] = list(self.hidden_sizes)
-        if self.her_lessons:  # absent when empty: checkpoints from before the field still resume
-            d["her_lessons"] = list(self.her_lessons)
-        else:
-            del d["her_lessons"]
+        d["her_lessons"] = list(self.her_lessons)
         return d
 
     @classmethod
@@ -138,7 +139,7 @@ class SACConfig:
         unknown = set(d) - fields
         if unknown:
             raise ValueError(f"unknown SACConfig fields: {sorted(unknown)}")
-        d = dict(d)
+        d = {**{k: v for k, v in cls.LEGACY_VALUES.items() if k not in d}, **d}
         for name in ("hidden_sizes", "her_lessons"):
             if name in d:
                 d[name] = tuple(d[name])
