@@ -116,12 +116,11 @@ class CurriculumRun:
         self.task_kwargs = dict(task_kwargs or {})
         self.layout = layout
         self.init_from = init_from
-        for lesson in plan:  # an unknown layout or a layout on dm_control fails here, not mid-run
-            as_domain(lesson.domain, layout)
-        arm_plan = [lesson for lesson in plan if as_domain(lesson.domain, layout).is_arm]
-        if config.her_ratio > 0 and config.her_lessons and arm_plan:  # a misspelt lesson would silently
+        # an unknown layout or a layout on dm_control fails here, not mid-run
+        arm_domains = {d for d in (as_domain(lesson.domain, layout) for lesson in plan) if d.is_arm}
+        if config.her_ratio > 0 and config.her_lessons and arm_domains:  # a misspelt lesson would silently
             # turn hindsight goals off (dm_control's tasks have no goal reward: HER does not apply there)
-            known = {task for lesson in arm_plan for task in as_domain(lesson.domain, layout).tasks()}
+            known = {task for domain in arm_domains for task in domain.tasks()}
             unknown = sorted(set(config.her_lessons) - known)
             if unknown:
                 raise ValueError(f"her_lessons names {unknown}, not a task of this plan's domains "

@@ -439,8 +439,9 @@ def main(argv=None):
     plan = plan_from_args(args)
     total = sum(l.steps for l in plan)
     final = plan[-1]
-    args.layout = resolve_layout(args.layout, Domain(final.domain))
-    args.task_kwargs = resolve_task_kwargs(args.task_kwargs, Domain(final.domain))
+    final_domain = Domain(final.domain)
+    args.layout = resolve_layout(args.layout, final_domain)
+    args.task_kwargs = resolve_task_kwargs(args.task_kwargs, final_domain)
     domain = Domain(final.domain, args.layout)
     for lesson in plan:  # a typo fails now, not after the first lessons have trained
         Domain(lesson.domain).check_task(lesson.task)
