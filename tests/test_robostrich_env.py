@@ -350,3 +350,36 @@ def test_one_target_may_be_given_as_a_pair():
     env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=0, target_pool=[0.3, 0.4]))
     env.reset()
     np.testing.assert_array_equal(env.task.target_position, [0.3, 0.4])
+
+
+def test_failure_sampling_draws_the_targets_the_agent_misses_more_often():
+    """target_sampling="failures": with a hold-still policy, the target at the start pose is
+    reached and the one 58 cm away never is; the far one must then be drawn far more often
+    than uniform sampling's half, and continued episodes still start where the last one ended."""
+    start = robostrich_suite.load("robostrich", "lesson1").reset().observation["head_position"]
+    far = start + np.array([0.3, -0.5])
+    pool = np.stack([start, far])
+    draws = {}
+    for sampling in ("uniform", "failures"):
+        env = robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(
+            target_sampling=sampling, target_pool=pool, time_limit=0.1, random=3,
+            attitude_tolerance=180.0))
+        far_draws = 0
+        final = None
+        for _ in range(40):
+            ts = env.reset()
+            if final is not None:  # scoring the last episode must not move the continued start
+                np.testing.assert_array_equal(ts.observation["joint_angles"], final)
+            far_draws += int(np.array_equal(ts.observation["target_position"], far))
+            while not ts.last():
+                ts = env.step(np.zeros(9))
+            final = ts.observation["joint_angles"]
+        draws[sampling] = far_draws
+        if sampling == "failures":
+            tries, failures = env.task.target_tries, env.task.target_failures
+            assert tries.sum() == 39  # every episode but the one still running
+            assert failures[0] == 0 and failures[1] == tries[1]
+    assert 12 <= draws["uniform"] <= 28
+    assert draws["failures"] >= 32
+    with pytest.raises(ValueError, match="unknown target_sampling 'worst'"):
+        robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(target_sampling="worst"))

@@ -33,6 +33,10 @@ from robostrich_suite.tasks.conventions import POSITION_TOLERANCE
 
 INITIAL_STATES = ("fixed", "continue")
 REWARDS = ("lesson1", "lesson2")
+# How the next target is drawn from the pool: "uniform" (the paper), or "failures": each
+# target in proportion to its estimated failure rate, (failures + 1) / (tries + 2), judged
+# on the previous episode's final pose against what the lesson's reward asks for.
+TARGET_SAMPLINGS = ("uniform", "failures")
 
 
 def validate_action(action, size: int) -> np.ndarray:
@@ -84,12 +88,18 @@ def check_action(action: np.ndarray, control_range: np.ndarray) -> np.ndarray:
 class Reach(base.Task):
     """Bring the head to a target position (and, from lesson 2, hold it level)."""
 
+    # Class-level defaults, so that an environment pickled before target sampling existed
+    # (a checkpoint's) still unpickles into a working task.
+    target_sampling = "uniform"
+    _target_index = None
+
     def __init__(self, reward: str = "lesson2", initial_state: str = "fixed",
                  target_pool=None, position_tolerance: float = POSITION_TOLERANCE,
                  attitude_tolerance: float = ATTITUDE_TOLERANCE,
                  desired_attitude: float = DESIRED_ATTITUDE,
                  weights: rewards.RewardWeights | dict | None = None,
-                 target_axes=(0, 2), randomization=None, random=None):
+                 target_axes=(0, 2), randomization=None, target_sampling: str = "uniform",
+                 random=None):
         """
         Args:
           reward: ``"lesson1"`` (eq. 9) or ``"lesson2"`` (eq. 10).
@@ -102,11 +112,15 @@ class Reach(base.Task):
           target_axes: world axes of the head position the targets are given in.
           randomization: a ``DomainRandomization`` (or a dict of its fields) to draw
             new arm parameters every episode and add joint-angle noise; None = off.
+          target_sampling: ``"uniform"`` or ``"failures"`` (targets the agent misses are
+            drawn more often; see ``TARGET_SAMPLINGS``).
         """
         if reward not in REWARDS:
             raise ValueError(f"unknown reward {reward!r}; use one of {REWARDS}")
         if initial_state not in INITIAL_STATES:
             raise ValueError(f"unknown initial_state {initial_state!r}; use one of {INITIAL_STATES}")
+        if target_sampling not in TARGET_SAMPLINGS:
+            raise ValueError(f"unknown target_sampling {target_sampling!r}; use one of {TARGET_SAMPLINGS}")
         if target_pool is None:
             from robostrich_suite import targets
             target_pool = targets.training_targets()
@@ -120,7 +134,8 @@ class Reach(base.Task):
             weights = rewards.RewardWeights(**weights)
         self.reward_name = reward
         self.initial_state = initial_state
-        self.target_pool = target_pool
+        self.target_sampling = target_sampling
+        self.set_target_pool(target_pool)
         self.position_tolerance = float(position_tolerance)
         self.attitude_tolerance = float(attitude_tolerance)
         self.desired_attitude = float(desired_attitude)
@@ -131,29 +146,53 @@ class Reach(base.Task):
             randomization = randomization_lib.DomainRandomization(**randomization)
         self.randomizer = (randomization_lib.Randomizer(randomization)
                            if randomization is not None else None)
-        self.target_position = target_pool[0].copy()
+        self.target_position = self.target_pool[0].copy()
         self._last_state = None
         super().__init__(random=random)
 
     # --- episode structure -------------------------------------------------
     def initialize_episode(self, physics):
+        if self.target_sampling == "failures" and self._last_state is not None:
+            self._count_previous_episode(physics)
         if self.randomizer is not None:
             self.randomizer.apply(physics, self.random)
         if self.initial_state == "continue" and self._last_state is not None:
-            qpos, qvel, act, command = self._last_state
-            with physics.reset_context():
-                physics.data.qpos[:] = qpos
-                physics.data.qvel[:] = qvel
-                if act.size:
-                    physics.data.act[:] = act
-                physics.set_arm_control(command)  # the servos keep their command, as a real arm's would
+            self._restore_last_state(physics)
         self.target_position = self.next_target()
         super().initialize_episode(physics)
 
+    def _restore_last_state(self, physics):
+        qpos, qvel, act, command = self._last_state
+        with physics.reset_context():
+            physics.data.qpos[:] = qpos
+            physics.data.qvel[:] = qvel
+            if act.size:
+                physics.data.act[:] = act
+            physics.set_arm_control(command)  # the servos keep their command, as a real arm's would
+
+    def _count_previous_episode(self, physics):
+        """Score the episode that just ended (its final pose against its target) for
+        ``target_sampling="failures"``; the physics is reset again afterwards."""
+        index = self._target_index
+        if index is None:
+            return
+        self._restore_last_state(physics)
+        reached = self.position_error(physics) <= self.position_tolerance
+        if self.reward_name != "lesson1":  # eq. 9 asks for the position alone
+            reached = reached and abs(self.attitude_error(physics)) <= self.attitude_tolerance
+        self.target_tries[index] += 1
+        self.target_failures[index] += not reached
+        with physics.reset_context():
+            pass  # back to the reset state the episode starts from
+
     def set_target_pool(self, targets) -> None:
         """Draw the next episodes' targets from ``targets`` ((n, 2) or one (2,) position):
-        an evaluation reuses one compiled environment for many targets this way."""
+        an evaluation reuses one compiled environment for many targets this way. The
+        failure counts of ``target_sampling="failures"`` start again from zero."""
         self.target_pool = as_targets(targets, "target_pool")
+        self.target_tries = np.zeros(len(self.target_pool), np.int64)
+        self.target_failures = np.zeros(len(self.target_pool), np.int64)
+        self._target_index = None
 
     def set_initial_state(self, initial_state: str) -> None:
         """``"fixed"`` or ``"continue"`` from the next episode on (see the module doc)."""
@@ -166,7 +205,13 @@ class Reach(base.Task):
         self._last_state = None
 
     def next_target(self) -> np.ndarray:
-        return self.target_pool[self.random.randint(len(self.target_pool))].copy()
+        if self.target_sampling == "failures":
+            failure_rate = (self.target_failures + 1.0) / (self.target_tries + 2.0)
+            self._target_index = int(self.random.choice(len(self.target_pool),
+                                                        p=failure_rate / failure_rate.sum()))
+        else:
+            self._target_index = int(self.random.randint(len(self.target_pool)))
+        return self.target_pool[self._target_index].copy()
 
     def action_spec(self, physics):
         """The tendon contractions (m), named after the tendons; nothing else is actuated."""
