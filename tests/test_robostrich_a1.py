@@ -314,3 +314,21 @@ def test_trunk_frame_and_head_attitude_turn_with_the_trunk():
         np.radians([10, 15, 15, 20, 15, 15]))
     physics.forward()
     assert physics.head_attitude() == pytest.approx(90.0, abs=1e-6)
+
+
+def test_failure_sampling_leaves_the_standing_start_alone():
+    """Scoring the last episode for target_sampling="failures" must not move the physics: the
+    quadruped is placed and settled before the arm's episode starts."""
+    starts = {}
+    for sampling in ("uniform", "failures"):
+        env = robostrich_suite.load("robostrich_a1", "lesson1", task_kwargs=dict(
+            target_sampling=sampling, random=0, time_limit=0.05))
+        for _ in range(2):
+            ts = env.reset()
+            starts[sampling] = (env.physics.data.qpos.copy(), env.physics.data.time)
+            while not ts.last():
+                ts = env.step(np.zeros(env.action_spec().shape))
+        if sampling == "failures":
+            assert env.task.target_tries.sum() == 1
+    np.testing.assert_array_equal(starts["uniform"][0], starts["failures"][0])
+    assert starts["uniform"][1] == starts["failures"][1]

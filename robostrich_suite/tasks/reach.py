@@ -92,6 +92,7 @@ class Reach(base.Task):
     # (a checkpoint's) still unpickles into a working task.
     target_sampling = "uniform"
     _target_index = None
+    _last_reached = None
 
     def __init__(self, reward: str = "lesson2", initial_state: str = "fixed",
                  target_pool=None, position_tolerance: float = POSITION_TOLERANCE,
@@ -152,8 +153,8 @@ class Reach(base.Task):
 
     # --- episode structure -------------------------------------------------
     def initialize_episode(self, physics):
-        if self.target_sampling == "failures" and self._last_state is not None:
-            self._count_previous_episode(physics)
+        if self.target_sampling == "failures":  # before anything moves the physics
+            self._count_previous_episode()
         if self.randomizer is not None:
             self.randomizer.apply(physics, self.random)
         if self.initial_state == "continue" and self._last_state is not None:
@@ -170,20 +171,19 @@ class Reach(base.Task):
                 physics.data.act[:] = act
             physics.set_arm_control(command)  # the servos keep their command, as a real arm's would
 
-    def _count_previous_episode(self, physics):
-        """Score the episode that just ended (its final pose against its target) for
-        ``target_sampling="failures"``; the physics is reset again afterwards."""
-        index = self._target_index
-        if index is None:
-            return
-        self._restore_last_state(physics)
+    def _count_previous_episode(self):
+        """Score the episode that just ended for ``target_sampling="failures"``: whether its
+        final pose (recorded by ``after_step``) did what the lesson asks."""
+        if self._target_index is not None and self._last_reached is not None:
+            self.target_tries[self._target_index] += 1
+            self.target_failures[self._target_index] += not self._last_reached
+        self._last_reached = None
+
+    def _lesson_reached(self, physics) -> bool:
         reached = self.position_error(physics) <= self.position_tolerance
         if self.reward_name != "lesson1":  # eq. 9 asks for the position alone
             reached = reached and abs(self.attitude_error(physics)) <= self.attitude_tolerance
-        self.target_tries[index] += 1
-        self.target_failures[index] += not reached
-        with physics.reset_context():
-            pass  # back to the reset state the episode starts from
+        return bool(reached)
 
     def set_target_pool(self, targets) -> None:
         """Draw the next episodes' targets from ``targets`` ((n, 2) or one (2,) position):
@@ -229,6 +229,8 @@ class Reach(base.Task):
                                 physics.data.act.copy(), physics.arm_control())
         else:
             self._last_state = None
+        if self.target_sampling == "failures":  # only then: it costs a head measurement per step
+            self._last_reached = None if physics.divergence is not None else self._lesson_reached(physics)
 
     def get_termination(self, physics):
         if physics.divergence is not None:
