@@ -62,6 +62,18 @@ def resolve_task_kwargs(task_kwargs: dict, domain: Domain) -> dict:
     return merged
 
 
+def check_task_kwargs(plan, layout, task_kwargs: dict) -> None:
+    """Build each lesson's environment once with ``task_kwargs``, so that an unknown option or a
+    bad value is a one-line error naming --task-kwargs now, not a worker's traceback later."""
+    for domain_name, task in dict.fromkeys((lesson.domain, lesson.task) for lesson in plan):
+        try:
+            env = Domain(domain_name, layout).make_environment(task, 0, **task_kwargs)
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"--task-kwargs {json.dumps(task_kwargs, default=str)} does not suit "
+                             f"{domain_name}/{task}: {error}") from error
+        env.close()
+
+
 def lesson_text(run) -> str:
     """'2/3': the lesson a run is in, for the progress bar."""
     return f"{run.lesson_index + 1 if not run.done else len(run.plan)}/{len(run.plan)}"
@@ -445,6 +457,7 @@ def main(argv=None):
     domain = Domain(final.domain, args.layout)
     for lesson in plan:  # a typo fails now, not after the first lessons have trained
         Domain(lesson.domain).check_task(lesson.task)
+    check_task_kwargs(plan, args.layout, args.task_kwargs)
     heldout_task = args.heldout_task or domain.heldout_task(final.task)
     track_task = domain.track_task(args.track_task)
     run_plans = {"curriculum": plan}

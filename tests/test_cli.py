@@ -149,6 +149,8 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
         "layout": start("robostrich-train", "--layout", "tangled", "--quiet", "--out", tmp_path / "lay"),
         "task": start("robostrich-train", "--plan", "lesson1:10,lesson9:10", "--quiet", "--out", tmp_path / "task"),
         "xml_no_out": start("robostrich-export-xml"),  # no default: it would write into the installed package
+        "task_kwargs": start("robostrich-train", "--task-kwargs", '{"target_sampling": "worst"}', "--quiet",
+                             "--out", tmp_path / "tk"),
     }
     results = {case: finish(p) for case, p in cases.items()}
     assert_user_error(results["resume_empty"], "--resume", "no checkpoint", str(empty))
@@ -163,7 +165,10 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     assert_user_error(results["task"], "no task 'lesson9'")
     assert not (tmp_path / "lay").exists() and not (tmp_path / "task").exists()
     assert_user_error(results["xml_no_out"], "--out")
-    for case in ("resume_empty", "truncated", "empty", "ramp_negative", "layout", "task", "xml_no_out"):
+    assert_user_error(results["task_kwargs"], "--task-kwargs", "robostrich/lesson1", "unknown target_sampling 'worst'")
+    assert not (tmp_path / "tk").exists()
+    for case in ("resume_empty", "truncated", "empty", "ramp_negative", "layout", "task", "xml_no_out",
+                 "task_kwargs"):
         assert results[case].returncode == 2, (case, results[case].stderr)
 
 
