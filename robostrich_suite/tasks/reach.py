@@ -180,10 +180,9 @@ class Reach(base.Task):
         self._last_reached = None
 
     def _lesson_reached(self, physics) -> bool:
-        reached = self.position_error(physics) <= self.position_tolerance
-        if self.reward_name != "lesson1":  # eq. 9 asks for the position alone
-            reached = reached and abs(self.attitude_error(physics)) <= self.attitude_tolerance
-        return bool(reached)
+        if self.reward_name == "lesson1":  # eq. 9 asks for the position alone
+            return self.position_error(physics) <= self.position_tolerance
+        return self.is_success(physics)
 
     def set_target_pool(self, targets) -> None:
         """Draw the next episodes' targets from ``targets`` ((n, 2) or one (2,) position):
