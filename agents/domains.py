@@ -109,6 +109,8 @@ class Domain:
     def make_environment(self, task: str, seed: int, **task_kwargs):
         """robostrich_suite.load for the arm (with the layout's kwargs), dm_control.suite.load otherwise."""
         task_kwargs = {"random": seed, **self.layout_kwargs(task), **task_kwargs}
+        if self.is_arm and task_kwargs.get("stored_starts") and task_kwargs.get("start_inputs") is None:
+            task_kwargs["start_inputs"] = self.stored_start_inputs()
         if self.is_arm:
             import robostrich_suite
             return robostrich_suite.load(self.name, task, task_kwargs=task_kwargs)
@@ -158,6 +160,18 @@ class Domain:
         starts = reach.default_track_targets(
             self._to_domain_frame(targets.training_targets(self._target_file())), count)
         return starts, np.stack([table["control"][nearest(table, s)] for s in starts])
+
+    def stored_start_inputs(self, exclusion: float = 0.02) -> np.ndarray:
+        """Tendon inputs for lesson 3's ``stored_starts``: the lookup table's (so no held-out
+        pose), minus every pose within `exclusion` (m) of the evaluation's moving starts, so the
+        moving-start evaluation still starts where training never started."""
+        if self.on_quadruped:
+            raise ValueError("stored_starts settles the arm holding stored inputs on the frame; "
+                             f"{self.name!r} stands on a quadruped, where it is not supported")
+        table = self.lookup_table()
+        starts, _ = self.moving_starts()
+        distance = np.linalg.norm(table["head_position"][:, None, :] - starts[None, :, :], axis=2).min(axis=1)
+        return table["control"][distance >= exclusion]
 
     def describe(self) -> str:
         return self.name if self.layout is None else f"{self.name} (layout {self.layout})"

@@ -146,3 +146,18 @@ def jax_leaves(tree):
     leaves = jax.tree_util.tree_leaves(tree)
     assert leaves
     return [np.asarray(leaf) for leaf in leaves]
+
+
+def test_stored_starts_come_from_the_lookup_table_without_the_evaluations_moving_starts():
+    """The agent layer fills lesson 3's start_inputs from the layout's lookup table (no held-out
+    pose), leaving out the poses the moving-start evaluation starts from."""
+    domain = Domain("robostrich", LAYOUT)
+    table, (starts, start_controls) = domain.lookup_table(), domain.moving_starts()
+    inputs = domain.stored_start_inputs()
+    assert 0 < len(inputs) < len(table["control"])
+    for control in start_controls:
+        assert not np.any(np.all(inputs == control, axis=1))
+    env = domain.make_environment("lesson3", 0, stored_starts=0.5)
+    np.testing.assert_array_equal(env.task.start_inputs, inputs)
+    with pytest.raises(ValueError, match="quadruped"):
+        Domain("robostrich_a1").make_environment("lesson3", 0, stored_starts=0.5)

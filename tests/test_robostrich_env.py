@@ -383,3 +383,35 @@ def test_failure_sampling_draws_the_targets_the_agent_misses_more_often():
     assert draws["failures"] >= 32
     with pytest.raises(ValueError, match="unknown target_sampling 'worst'"):
         robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(target_sampling="worst"))
+
+
+def test_stored_starts_begin_lesson3_episodes_where_a_stored_input_holds_the_arm():
+    """stored_starts=1: every lesson-3 episode starts at rest where the stored input holds the head
+    (the stored pose itself: its head position within 1 cm, level), with the clock at 0; 0 (the
+    default) keeps the paper's continued starts; bad values are errors that name the option."""
+    poses = targets.level_head_poses()
+    inputs, positions = poses["control"][:2], poses["head_position"][:2]
+    env = robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(
+        stored_starts=1.0, start_inputs=inputs, random=0, time_limit=0.1))
+    started = set()
+    for _ in range(6):
+        ts = env.reset()
+        assert env.physics.time() == 0.0
+        head = ts.observation["head_position"]
+        nearest = int(np.argmin(np.linalg.norm(positions - head, axis=1)))
+        assert np.linalg.norm(positions[nearest] - head) < 0.01
+        assert abs(env.task.attitude_error(env.physics)) < 5.0
+        assert np.abs(env.physics.data.qvel).max() < 0.05  # at rest, not mid-swing
+        started.add(nearest)
+        while not ts.last():
+            ts = env.step(np.full(9, 0.01))
+    assert started == {0, 1}  # both inputs drawn in 6 episodes
+    # lesson 2 starts fixed whatever the option says (one --task-kwargs serves every lesson)
+    fixed = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(stored_starts=1.0, start_inputs=inputs))
+    np.testing.assert_array_equal(fixed.reset().observation["joint_angles"], np.zeros(18))
+    with pytest.raises(ValueError, match="stored_starts must be a share between 0 and 1, got 1.5"):
+        robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(stored_starts=1.5, start_inputs=inputs))
+    with pytest.raises(ValueError, match="stored_starts > 0 needs start_inputs"):
+        robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(stored_starts=0.5))
+    with pytest.raises(ValueError, match="start_inputs must be a non-empty"):
+        robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(stored_starts=0.5, start_inputs=[np.nan] * 9))

@@ -7,7 +7,10 @@ They differ in how an episode starts:
 * ``"fixed"``: the straight, upright pose at rest (lessons 1 and 2);
 * ``"continue"``: the final state of the previous episode (lesson 3), so the
   agent learns to move between targets; the first episode, and any episode
-  after a divergence, starts fixed.
+  after a divergence, starts fixed.  With ``stored_starts`` > 0, that share of
+  the episodes starts instead where the arm comes to rest holding one of
+  ``start_inputs`` (stored level poses), so the agent also learns to leave
+  poses it would never reach by itself.
 
 ``Track`` is the evaluation task of Fig. 7: a sequence of targets reached in
 order, one after another, within one episode.
@@ -37,6 +40,9 @@ REWARDS = ("lesson1", "lesson2")
 # target in proportion to its estimated failure rate, (failures + 1) / (tries + 2), judged
 # on the previous episode's final pose against what the lesson's reward asks for.
 TARGET_SAMPLINGS = ("uniform", "failures")
+# How long a stored start holds its inputs from the fixed pose before the episode begins: as
+# long as the evaluation's moving starts hold theirs (one 2 s episode), so the arm is at rest.
+STORED_START_SETTLE_TIME = 2.0  # s
 
 
 def validate_action(action, size: int) -> np.ndarray:
@@ -93,6 +99,8 @@ class Reach(base.Task):
     target_sampling = "uniform"
     _target_index = None
     _last_reached = None
+    stored_starts = 0.0
+    start_inputs = None
 
     def __init__(self, reward: str = "lesson2", initial_state: str = "fixed",
                  target_pool=None, position_tolerance: float = POSITION_TOLERANCE,
@@ -100,7 +108,7 @@ class Reach(base.Task):
                  desired_attitude: float = DESIRED_ATTITUDE,
                  weights: rewards.RewardWeights | dict | None = None,
                  target_axes=(0, 2), randomization=None, target_sampling: str = "uniform",
-                 random=None):
+                 stored_starts: float = 0.0, start_inputs=None, random=None):
         """
         Args:
           reward: ``"lesson1"`` (eq. 9) or ``"lesson2"`` (eq. 10).
@@ -115,6 +123,12 @@ class Reach(base.Task):
             new arm parameters every episode and add joint-angle noise; None = off.
           target_sampling: ``"uniform"`` or ``"failures"`` (targets the agent misses are
             drawn more often; see ``TARGET_SAMPLINGS``).
+          stored_starts: share (0-1) of a ``"continue"`` lesson's episodes that start where
+            the arm comes to rest holding one of ``start_inputs`` (drawn uniformly) from the
+            fixed pose for ``STORED_START_SETTLE_TIME``; 0 (default): the paper's lesson 3.
+            Ignored by ``"fixed"`` lessons, so one option can serve a whole curriculum.
+          start_inputs: (n, tendons) tendon inputs for ``stored_starts`` (the agent layer
+            passes the lookup table's, minus the evaluation's start poses).
         """
         if reward not in REWARDS:
             raise ValueError(f"unknown reward {reward!r}; use one of {REWARDS}")
@@ -133,6 +147,18 @@ class Reach(base.Task):
             raise ValueError(f"desired_attitude must be a finite angle in degrees, got {desired_attitude}")
         if isinstance(weights, dict):
             weights = rewards.RewardWeights(**weights)
+        if not (np.isfinite(stored_starts) and 0.0 <= stored_starts <= 1.0):
+            raise ValueError(f"stored_starts must be a share between 0 and 1, got {stored_starts}")
+        if stored_starts > 0:
+            if start_inputs is None:
+                raise ValueError("stored_starts > 0 needs start_inputs: the (n, tendons) tendon inputs "
+                                 "of the stored poses to start from")
+            start_inputs = np.asarray(start_inputs, np.float64)
+            if start_inputs.ndim != 2 or len(start_inputs) == 0 or not np.all(np.isfinite(start_inputs)):
+                raise ValueError("start_inputs must be a non-empty (n, tendons) array of finite tendon "
+                                 f"inputs, got shape {start_inputs.shape}")
+        self.stored_starts = float(stored_starts)
+        self.start_inputs = start_inputs
         self.reward_name = reward
         self.initial_state = initial_state
         self.target_sampling = target_sampling
@@ -157,8 +183,11 @@ class Reach(base.Task):
             self._count_previous_episode()
         if self.randomizer is not None:
             self.randomizer.apply(physics, self.random)
-        if self.initial_state == "continue" and self._last_state is not None:
-            self._restore_last_state(physics)
+        if self.initial_state == "continue":
+            if self.stored_starts and self.random.rand() < self.stored_starts:
+                self._settle_at_stored_input(physics)
+            elif self._last_state is not None:
+                self._restore_last_state(physics)
         self.target_position = self.next_target()
         super().initialize_episode(physics)
 
@@ -170,6 +199,17 @@ class Reach(base.Task):
             if act.size:
                 physics.data.act[:] = act
             physics.set_arm_control(command)  # the servos keep their command, as a real arm's would
+
+    def _settle_at_stored_input(self, physics):
+        """Hold one of ``start_inputs`` from the fixed pose until the arm is at rest, as the
+        evaluation's moving starts do; the episode's clock then starts at 0.  A divergence
+        while settling leaves the fixed pose (and is logged like any other)."""
+        inputs = self.start_inputs[self.random.randint(len(self.start_inputs))]
+        physics.set_arm_control(check_action(inputs, physics.arm_control_range()))
+        physics.step(int(round(STORED_START_SETTLE_TIME / physics.timestep())))
+        if physics.divergence is not None:
+            physics.reset()
+        physics.data.time = 0.0
 
     def _count_previous_episode(self):
         """Score the episode that just ended for ``target_sampling="failures"``: whether its
