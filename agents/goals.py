@@ -28,6 +28,10 @@ class GoalRelabeler:
         self.attitude = slices[task.ATTITUDE_ERROR_OBSERVATION]
         self.goal_size = self.goal.stop - self.goal.start
         self.reward_fn = task.goal_reward
+        # Reached poses farther than this from level (deg) are not goals the task could set;
+        # None: every reached position is one.
+        tolerance = getattr(task, "goal_attitude_tolerance", None)
+        self.goal_attitude_tolerance = tolerance() if callable(tolerance) else None
 
     @classmethod
     def for_environment(cls, env, flattener) -> Optional["GoalRelabeler"]:
@@ -55,6 +59,13 @@ class GoalRelabeler:
         if self.delta is not None:
             out[..., self.delta] = goal - flat_obs[..., self.achieved]
         return out
+
+    def settable(self, reached: np.ndarray) -> np.ndarray:
+        """Which reached poses (..., g + 1) (position, attitude error in deg) are goals the task
+        could set: all of them unless the task asks for a level head."""
+        if self.goal_attitude_tolerance is None:
+            return np.ones(reached.shape[:-1], bool)
+        return np.abs(reached[..., self.goal_size]) <= self.goal_attitude_tolerance
 
     def rewards(self, substep_goals: np.ndarray, substeps: np.ndarray, goal: np.ndarray) -> np.ndarray:
         """Summed reward of transitions whose control steps reached ``substep_goals``

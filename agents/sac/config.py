@@ -52,6 +52,10 @@ class SACConfig:
     # level head, which relabelled positions rarely had (docs/learning.md: 84.5 -> 96.4 % held-out).
     her_ratio: float = 0.5
     her_lessons: Tuple[str, ...] = ("lesson1",)
+    # Relabel only with reached poses that are goals the lesson could set: in lessons 2-3 a
+    # level head (within the attitude tolerance), so hindsight goals there are all level-head
+    # targets; lesson 1's eq. 9 ignores the attitude, so there every reached position is one.
+    her_level_goals: bool = False
     # Recompute every sampled transition's reward with the current lesson's reward function
     # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
     # replay then carry lesson-2 rewards instead of the ones they were collected with.

@@ -300,6 +300,12 @@ class Reach(base.Task):
     GOAL_DELTA_OBSERVATION = "to_target"
     ATTITUDE_ERROR_OBSERVATION = "attitude_error"  # rad
 
+    def goal_attitude_tolerance(self):
+        """How far from level (deg) a reached pose may be for its position to be a goal this
+        task could set: the attitude tolerance where the reward asks for a level head, None
+        in lesson 1 (eq. 9 ignores the attitude, so every reached position is one)."""
+        return None if self.reward_name == "lesson1" else self.attitude_tolerance
+
     def goal_reward(self, achieved, attitude_error_deg, goal) -> np.ndarray:
         """The reward this task gives with the head at ``achieved`` (..., 2), its attitude
         ``attitude_error_deg`` (...) off, had the target been ``goal`` (..., 2): eqs. 9-10
