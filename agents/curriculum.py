@@ -118,12 +118,15 @@ class CurriculumRun:
         self.init_from = init_from
         # an unknown layout or a layout on dm_control fails here, not mid-run
         arm_domains = {d for d in (as_domain(lesson.domain, layout) for lesson in plan) if d.is_arm}
-        if config.her_ratio > 0 and config.her_lessons and arm_domains:  # a misspelt lesson would silently
-            # turn hindsight goals off (dm_control's tasks have no goal reward: HER does not apply there)
-            known = {task for domain in arm_domains for task in domain.tasks()}
-            unknown = sorted(set(config.her_lessons) - known)
+        # A misspelt lesson would silently turn its setting off (dm_control's tasks have no goal
+        # reward, so HER does not apply there; a per-lesson discount applies to any plan).
+        named = {"her_lessons": config.her_lessons if config.her_ratio > 0 and arm_domains else (),
+                 "long_horizon_lessons": config.long_horizon_lessons}
+        known = {lesson.task for lesson in plan} | {task for domain in arm_domains for task in domain.tasks()}
+        for field, lessons in named.items():
+            unknown = sorted(set(lessons) - known)
             if unknown:
-                raise ValueError(f"her_lessons names {unknown}, not a task of this plan's domains "
+                raise ValueError(f"{field} names {unknown}, not a task of this plan's domains "
                                  f"(tasks: {', '.join(sorted(known))})")
         self.plan = list(plan)
         self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
@@ -145,8 +148,10 @@ class CurriculumRun:
                                 **self.task_kwargs)
 
     def _enter_lesson(self):
-        """What the loop changes with the lesson besides the environment: the hindsight share."""
+        """What the loop changes with the lesson besides the environment: the hindsight share and
+        the discount."""
         self.loop.her_ratio = self.config.her_ratio_in_lesson(self.lesson.task)
+        self.loop.learner.set_discount(self.config.discount_in_lesson(self.lesson.task))
 
     def lesson_checkpoint_path(self, lessons_done: int) -> str:
         """Where ``keep_lesson_checkpoints`` writes the checkpoint after ``lessons_done`` lessons."""

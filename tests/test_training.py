@@ -230,3 +230,37 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     assert training.resolve_task_kwargs({}, dmc) == {}
     with pytest.raises(ValueError, match="target_entropy_per_action"):
         SACConfig(target_entropy_per_action=float("nan"))
+
+
+def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resume(tmp_path):
+    """long_horizon_lessons: the named lesson trains with long_horizon_discount, the others with
+    discount; until that lesson starts the run is bit for bit the plain one, after it differs;
+    a run resumed inside the lesson keeps its discount; a misspelt lesson is an error."""
+    import dataclasses
+    plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
+    long = dataclasses.replace(TINY, long_horizon_lessons=("hard",), long_horizon_discount=0.9)
+    plain = CurriculumRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
+    other = CurriculumRun(plan, long, seed=0, run_dir=str(tmp_path / "long"), checkpoint_every=600)
+    assert other.loop.learner.config.discount == 0.99
+    for run in (plain, other):
+        with pytest.raises(TrainingInterrupted):
+            run.run(stop_at_step=400)
+    assert_same_run(plain, other)
+    assert other.loop.learner.config.discount == 0.9 and plain.loop.learner.config.discount == 0.99
+    plain.run()
+    with pytest.raises(TrainingInterrupted):
+        other.run(stop_at_step=600)
+    resumed = CurriculumRun(plan, long, seed=0, run_dir=str(tmp_path / "long"))
+    resumed.restore()
+    assert resumed.loop.learner.config.discount == 0.9
+    other.run()
+    resumed.run()
+    assert_same_run(resumed, other)
+    differs = [not np.array_equal(a, b) for a, b in zip(leaves(plain.loop.learner.state.q_params),
+                                                        leaves(other.loop.learner.state.q_params))]
+    assert all(differs)
+    with pytest.raises(ValueError, match=r"long_horizon_lessons names \['lesson3'\]"):
+        CurriculumRun(plan, dataclasses.replace(TINY, long_horizon_lessons=("lesson3",)), seed=0,
+                      run_dir=str(tmp_path / "bad"))
+    with pytest.raises(ValueError, match="long_horizon_discount must be in"):
+        dataclasses.replace(TINY, long_horizon_discount=1.5)

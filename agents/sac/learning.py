@@ -3,6 +3,7 @@
 `SACLearner.step(batches)` runs `batches.reward.shape[0]` updates inside a
 single `lax.scan`, so Python is entered once per call, not once per update.
 """
+import dataclasses
 import functools
 from typing import NamedTuple
 
@@ -137,6 +138,12 @@ class SACLearner:
         """batches: arrays with a leading [num_updates, batch_size] shape. Returns mean metrics (floats)."""
         self.state, metrics = self._update_many(self.state, batches)
         return metrics
+
+    def set_discount(self, discount: float) -> None:
+        """Train on with another discount (a curriculum's per-lesson discount); the state carries over."""
+        if discount != self.config.discount:
+            self.config = dataclasses.replace(self.config, discount=float(discount))
+            self._update_many = _jitted_update_many(self.networks, self.config)
 
     @property
     def policy_params(self):
