@@ -47,15 +47,15 @@ class SACConfig:
     # achieved head pose and the goal (robostrich's Reach; other tasks get none): this fraction of
     # every sampled batch gets a goal the head reached later in the same episode, with the reward
     # recomputed exactly. `her_lessons` names the lesson tasks that get it (empty = every task).
-    # Lesson 1 only: its eq.-9 reward depends on the head position and the goal alone, and without
-    # hindsight goals some seeds never learn the upper workspace there; lessons 2-3 also ask for a
-    # level head, which relabelled positions rarely had (docs/learning.md: 84.5 -> 96.4 % held-out).
+    # Lessons 1-3 of the arm, with `her_level_goals`: without hindsight goals in lesson 1 some seeds
+    # never learn the upper workspace (84.5 -> 96.4 % held-out); in lessons 2-3 plain relabelling
+    # hurt, because reached positions rarely had a level head (docs/learning.md).
     her_ratio: float = 0.5
-    her_lessons: Tuple[str, ...] = ("lesson1",)
+    her_lessons: Tuple[str, ...] = ("lesson1", "lesson2", "lesson3")
     # Relabel only with reached poses that are goals the lesson could set: in lessons 2-3 a
     # level head (within the attitude tolerance), so hindsight goals there are all level-head
     # targets; lesson 1's eq. 9 ignores the attitude, so there every reached position is one.
-    her_level_goals: bool = False
+    her_level_goals: bool = True
     # Lessons that train with `long_horizon_discount` instead of `discount` (empty: none). Moving
     # between targets (lesson 3) can mean swinging the neck through a whole turn, which takes the
     # arm longer than settling from the fixed start; 0.99 at 125 Hz looks 0.8 s ahead, 0.995 1.6 s.
@@ -76,7 +76,8 @@ class SACConfig:
 
     # What a field was, in effect, for checkpoints written before it existed: their fingerprints
     # lack it, and `from_dict` fills it in so that they still load, resume and compare equal.
-    LEGACY_VALUES: ClassVar[dict] = {"her_lessons": (), "target_entropy_per_action": -1.0}
+    LEGACY_VALUES: ClassVar[dict] = {"her_lessons": (), "target_entropy_per_action": -1.0,
+                                     "her_level_goals": False}
 
     def __post_init__(self):
         if min(self.batch_size, self.updates_per_call, self.env_steps_per_call, self.action_repeat) <= 0:
@@ -144,7 +145,7 @@ class SACConfig:
                       init_temperature=1.0, hidden_sizes=(256, 256), min_replay_size=10_000,
                       max_replay_size=1_000_000, updates_per_call=8, env_steps_per_call=8, action_repeat=1,
                       reward_scale=1.0, critic_layer_norm=False, her_ratio=0.0, her_lessons=(),
-                      relabel_rewards=False,
+                      her_level_goals=False, relabel_rewards=False,
                       residual_scale=0.0,
                       action_anchor=0.0)
         values.update(overrides)
