@@ -211,15 +211,15 @@ def test_lesson_checkpoints_hold_the_policy_after_each_lesson(tmp_path):
 
 def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_elsewhere():
     """The defaults are the measured recipe (docs/learning.md) on the arm domains: antagonist_pairs,
-    -2 entropy per tendon, HER in lessons 1-3 (level goals), the precision term; dm_control plans get none of the
+    -2 entropy per tendon, HER in lesson 1, the precision term; dm_control plans get none of the
     arm's settings, and the paper's routing and eq. 10 stay one flag away."""
     from agents.domains import Domain
     arm, dmc = Domain("robostrich"), Domain("reacher")
     config = SACConfig()
     assert config.resolved_target_entropy(9) == -18.0 and SACConfig.paper_sac().resolved_target_entropy(9) == -9.0
     assert SACConfig(target_entropy=-3.0).resolved_target_entropy(9) == -3.0  # an explicit value wins
-    assert [config.her_ratio_in_lesson(t) for t in ("lesson1", "lesson2", "lesson3", "lesson4")] == [0.5, 0.5, 0.5, 0.0]
-    assert config.her_level_goals and not SACConfig.paper_sac().her_level_goals
+    assert [config.her_ratio_in_lesson(t) for t in ("lesson1", "lesson2", "lesson3", "lesson4")] == [0.5, 0.0, 0.0, 0.0]
+    assert not config.her_level_goals and not SACConfig.paper_sac().her_level_goals
     assert training.resolve_layout(None, arm) == "antagonist_pairs"
     assert training.resolve_layout("paper", arm) is None  # the tasks' own layout, as older checkpoints name it
     assert training.resolve_layout("ventral_slips", arm) == "ventral_slips" and training.resolve_layout(None, dmc) is None
