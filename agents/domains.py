@@ -168,10 +168,9 @@ class Domain:
         if self.on_quadruped:
             raise ValueError("stored_starts settles the arm holding stored inputs on the frame; "
                              f"{self.name!r} stands on a quadruped, where it is not supported")
-        table = self.lookup_table()
+        from agents.lookup import lookup_table
         starts, _ = self.moving_starts()
-        distance = np.linalg.norm(table["head_position"][:, None, :] - starts[None, :, :], axis=2).min(axis=1)
-        return table["control"][distance >= exclusion]
+        return lookup_table(self.lookup_table(), heldout=starts, exclusion=exclusion)["control"]
 
     def describe(self) -> str:
         return self.name if self.layout is None else f"{self.name} (layout {self.layout})"

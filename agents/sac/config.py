@@ -79,6 +79,8 @@ class SACConfig:
     # lack it, and `from_dict` fills it in so that they still load, resume and compare equal.
     LEGACY_VALUES: ClassVar[dict] = {"her_lessons": (), "target_entropy_per_action": -1.0,
                                      "her_level_goals": False}
+    # Fields that name lesson tasks (tuples here, lists in a fingerprint).
+    LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons")
 
     def __post_init__(self):
         if min(self.batch_size, self.updates_per_call, self.env_steps_per_call, self.action_repeat) <= 0:
@@ -89,14 +91,11 @@ class SACConfig:
             raise ValueError(f"her_ratio must be in [0, 1], got {self.her_ratio}")
         if not 0.0 <= self.residual_scale <= 2.0:
             raise ValueError(f"residual_scale must be in [0, 2] (0 = no residual), got {self.residual_scale}")
-        if isinstance(self.her_lessons, str) or not all(isinstance(t, str) and t for t in self.her_lessons):
-            raise ValueError(f"her_lessons must be a tuple of task names, e.g. ('lesson1',), got {self.her_lessons!r}")
-        object.__setattr__(self, "her_lessons", tuple(self.her_lessons))
-        if isinstance(self.long_horizon_lessons, str) or not all(isinstance(t, str) and t
-                                                                  for t in self.long_horizon_lessons):
-            raise ValueError("long_horizon_lessons must be a tuple of task names, e.g. ('lesson3',), "
-                             f"got {self.long_horizon_lessons!r}")
-        object.__setattr__(self, "long_horizon_lessons", tuple(self.long_horizon_lessons))
+        for name in self.LESSON_LIST_FIELDS:
+            lessons = getattr(self, name)
+            if isinstance(lessons, str) or not all(isinstance(t, str) and t for t in lessons):
+                raise ValueError(f"{name} must be a tuple of task names, e.g. ('lesson1',), got {lessons!r}")
+            object.__setattr__(self, name, tuple(lessons))
         for name in ("discount", "long_horizon_discount"):
             if not 0.0 < getattr(self, name) <= 1.0:
                 raise ValueError(f"{name} must be in (0, 1], got {getattr(self, name)}")
@@ -132,8 +131,8 @@ class SACConfig:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d["hidden_sizes"] = list(self.hidden_sizes)
-        d["her_lessons"] = list(self.her_lessons)
-        d["long_horizon_lessons"] = list(self.long_horizon_lessons)
+        for name in self.LESSON_LIST_FIELDS:
+            d[name] = list(getattr(self, name))
         return d
 
     @classmethod
@@ -164,7 +163,7 @@ class SACConfig:
         if unknown:
             raise ValueError(f"unknown SACConfig fields: {sorted(unknown)}")
         d = {**{k: v for k, v in cls.LEGACY_VALUES.items() if k not in d}, **d}
-        for name in ("hidden_sizes", "her_lessons", "long_horizon_lessons"):
+        for name in ("hidden_sizes", *cls.LESSON_LIST_FIELDS):
             if name in d:
                 d[name] = tuple(d[name])
         return cls(**d)
