@@ -91,6 +91,21 @@ def run_files(run_dir: str) -> Tuple[str, str, str]:
             os.path.join(run_dir, "evals.jsonl"))
 
 
+def check_lesson_names(plan, config: SACConfig, arm_domains) -> None:
+    """ValueError naming the field if a per-lesson setting names a task the plan's domains lack:
+    a misspelt lesson would silently turn its setting off (dm_control's tasks have no goal reward,
+    so HER does not apply there; a per-lesson discount applies to any plan). `arm_domains`: the
+    plan's arm Domains."""
+    named = {"her_lessons": config.her_lessons if config.her_ratio > 0 and arm_domains else (),
+             "long_horizon_lessons": config.long_horizon_lessons}
+    known = {lesson.task for lesson in plan} | {task for domain in arm_domains for task in domain.tasks()}
+    for field, lessons in named.items():
+        unknown = sorted(set(lessons) - known)
+        if unknown:
+            raise ValueError(f"{field} names {unknown}, not a task of this plan's domains "
+                             f"(tasks: {', '.join(sorted(known))})")
+
+
 class CurriculumRun:
     """A learner, its replay and its position in a lesson plan, with checkpoints.
 
@@ -118,16 +133,7 @@ class CurriculumRun:
         self.init_from = init_from
         # an unknown layout or a layout on dm_control fails here, not mid-run
         arm_domains = {d for d in (as_domain(lesson.domain, layout) for lesson in plan) if d.is_arm}
-        # A misspelt lesson would silently turn its setting off (dm_control's tasks have no goal
-        # reward, so HER does not apply there; a per-lesson discount applies to any plan).
-        named = {"her_lessons": config.her_lessons if config.her_ratio > 0 and arm_domains else (),
-                 "long_horizon_lessons": config.long_horizon_lessons}
-        known = {lesson.task for lesson in plan} | {task for domain in arm_domains for task in domain.tasks()}
-        for field, lessons in named.items():
-            unknown = sorted(set(lessons) - known)
-            if unknown:
-                raise ValueError(f"{field} names {unknown}, not a task of this plan's domains "
-                                 f"(tasks: {', '.join(sorted(known))})")
+        check_lesson_names(plan, config, arm_domains)
         self.plan = list(plan)
         self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
         self.checkpoint_every = int(checkpoint_every)

@@ -25,8 +25,8 @@ from typing import Optional
 import numpy as np
 
 from agents import evaluation
-from agents.curriculum import (CurriculumRun, Lesson, format_plan, parse_plan, run_files, run_identity,
-                               upgrade_fingerprint)
+from agents.curriculum import (CurriculumRun, Lesson, check_lesson_names, format_plan, parse_plan, run_files,
+                               run_identity, upgrade_fingerprint)
 from agents.domains import Domain
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
@@ -458,6 +458,7 @@ def main(argv=None):
     for lesson in plan:  # a typo fails now, not after the first lessons have trained
         Domain(lesson.domain).check_task(lesson.task)
     check_task_kwargs(plan, args.layout, args.task_kwargs)
+    check_lesson_names(plan, config, {d for d in (Domain(l.domain, args.layout) for l in plan) if d.is_arm})
     heldout_task = args.heldout_task or domain.heldout_task(final.task)
     track_task = domain.track_task(args.track_task)
     run_plans = {"curriculum": plan}

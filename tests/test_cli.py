@@ -151,6 +151,8 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
         "xml_no_out": start("robostrich-export-xml"),  # no default: it would write into the installed package
         "task_kwargs": start("robostrich-train", "--task-kwargs", '{"target_sampling": "worst"}', "--quiet",
                              "--out", tmp_path / "tk"),
+        "lesson_names": start("robostrich-train", "--long-horizon-lessons", "lesson9", "--quiet",
+                              "--out", tmp_path / "ln"),
     }
     results = {case: finish(p) for case, p in cases.items()}
     assert_user_error(results["resume_empty"], "--resume", "no checkpoint", str(empty))
@@ -167,8 +169,10 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     assert_user_error(results["xml_no_out"], "--out")
     assert_user_error(results["task_kwargs"], "--task-kwargs", "robostrich/lesson1", "unknown target_sampling 'worst'")
     assert not (tmp_path / "tk").exists()
+    assert_user_error(results["lesson_names"], "long_horizon_lessons names ['lesson9']")
+    assert not (tmp_path / "ln").exists()
     for case in ("resume_empty", "truncated", "empty", "ramp_negative", "layout", "task", "xml_no_out",
-                 "task_kwargs"):
+                 "task_kwargs", "lesson_names"):
         assert results[case].returncode == 2, (case, results[case].stderr)
 
 
