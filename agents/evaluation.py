@@ -20,6 +20,7 @@ import numpy as np
 from agents import probes
 from agents.curriculum import make_environment
 from agents.domains import MOVING_START_TASK, as_domain
+from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, PRECISE_POSITION_TOLERANCE
 
 
 def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dict:
@@ -73,7 +74,8 @@ def _episode_summary(series, start=0, end=None) -> dict:
 
 
 def summarize(episodes) -> dict:
-    """Success and final errors (robostrich, point_mass); only return statistics where errors are unknown."""
+    """Success (the task's tolerances, and the precise reach of ``conventions``) and final errors
+    (robostrich, point_mass); only return statistics where errors are unknown."""
     returns = np.array([e["return"] for e in episodes], np.float64)
     return_stats = {"return_mean": float(returns.mean()), "return_std": float(returns.std()),
                     "return_min": float(returns.min()), "return_max": float(returns.max())}
@@ -85,6 +87,9 @@ def summarize(episodes) -> dict:
     return {
         "episodes": len(episodes),
         "success_rate": float(np.mean([e["success"] for e in episodes])),
+        "precise_success_rate": float(np.mean((pe <= PRECISE_POSITION_TOLERANCE)
+                                              & (np.abs(ae) <= PRECISE_ATTITUDE_TOLERANCE_DEG))),
+        "precise_tolerances": [PRECISE_POSITION_TOLERANCE, PRECISE_ATTITUDE_TOLERANCE_DEG],
         "position_error_median": float(np.median(pe)), "position_error_p90": float(np.percentile(pe, 90)),
         "attitude_error_median": float(np.median(ae)), "attitude_error_p90": float(np.percentile(ae, 90)),
         "reached_fraction": len(reach) / len(episodes),

@@ -16,6 +16,7 @@ from typing import NamedTuple
 
 import mujoco as mujoco_lib
 import numpy as np
+from dm_control.mujoco import engine
 from dm_control.rl import control
 
 from robostrich_suite.model import arm as arm_lib
@@ -23,6 +24,8 @@ from robostrich_suite.model import quadruped as quad
 from robostrich_suite.tasks import gait as gait_lib
 
 _log = logging.getLogger(__name__)
+# dm_control's message for an invalid state, so both step paths report it alike.
+_INVALID_STATE = engine._INVALID_PHYSICS_STATE
 
 
 _COUNTS = {"body": "nbody", "joint": "njnt", "actuator": "nu", "tendon": "ntendon",
@@ -52,6 +55,25 @@ class ArmIndices(NamedTuple):
     # Length of each tendon in the straight pose (m): the servo's zero contraction,
     # (kp * rest) / kp, fixed at model creation (randomisation scales kp and bias together).
     rest_lengths: np.ndarray
+    # ``qpos``, ``actuators`` and ``tendons`` as slices where the ids are evenly spaced (the
+    # frame arm's and the quadruped's are; :func:`as_slice`): the per-step accessors read
+    # through these.
+    qpos_select: slice | np.ndarray
+    actuator_select: slice | np.ndarray
+    tendon_select: slice | np.ndarray
+    rk4: bool  # the model integrates with RK4 (dm_control's step then skips mj_step2)
+
+
+def as_slice(ids) -> slice | np.ndarray:
+    """``ids`` (non-negative) as a slice that reads the same elements in the same order
+    where they are evenly spaced, else ``ids`` as an array: a slice reads a view without
+    numpy's fancy-indexing cost, which the per-step paths pay for every read."""
+    ids = np.asarray(ids, dtype=int)
+    if len(ids) < 2 or ids[1] == ids[0] or np.any(np.diff(ids) != ids[1] - ids[0]):
+        return ids
+    step = int(ids[1] - ids[0])
+    stop = int(ids[-1]) + step
+    return slice(int(ids[0]), None if stop < 0 else stop, step)
 
 
 def arm_indices(model) -> ArmIndices:
@@ -65,11 +87,13 @@ def arm_indices(model) -> ArmIndices:
     sensor = model.name2id(f"{arm_lib.ARM_MODEL_NAME}/{arm_lib.HEAD_VELOCITY_SENSOR}", "sensor")
     servo_gain = -model.actuator_gainprm[actuators, 0].copy()
     servo_bias = model.actuator_biasprm[actuators, 0].copy()
-    return ArmIndices(joints, np.array(model.jnt_qposadr[joints]),
-                      np.array(model.jnt_dofadr[joints]), actuators,
-                      np.array(model.actuator_trnid[actuators, 0], dtype=int), head_site,
-                      int(model.site_bodyid[head_site]), int(model.sensor_adr[sensor]),
-                      servo_gain, servo_bias, servo_bias / servo_gain)
+    qpos = np.array(model.jnt_qposadr[joints])
+    tendons = np.array(model.actuator_trnid[actuators, 0], dtype=int)
+    return ArmIndices(joints, qpos, np.array(model.jnt_dofadr[joints]), actuators, tendons,
+                      head_site, int(model.site_bodyid[head_site]), int(model.sensor_adr[sensor]),
+                      servo_gain, servo_bias, servo_bias / servo_gain,
+                      as_slice(qpos), as_slice(actuators), as_slice(tendons),
+                      int(model.opt.integrator) == int(mujoco_lib.mjtIntegrator.mjINT_RK4))
 
 
 def tendon_sides(model) -> list[str]:
@@ -144,7 +168,8 @@ def _continuous_attitude(axis_angle_rad: float, joint_angles_rad: np.ndarray) ->
     """:func:`continuous_attitude_deg` of one pose in plain floats (same result): the
     physics accessors run it twice per control step."""
     axis_angle = math.degrees(axis_angle_rad)
-    turns = (math.degrees(joint_angles_rad.sum()) - axis_angle) / 360.0
+    # np.add.reduce is ndarray.sum without its Python-level dispatch: the same pairwise sum
+    turns = (math.degrees(np.add.reduce(joint_angles_rad)) - axis_angle) / 360.0
     return axis_angle + 360.0 * round(turns) if math.isfinite(turns) else math.nan
 
 
@@ -198,7 +223,8 @@ class ArmPhysicsMixin:
     def tendon_names(self) -> list[str]:
         return [self.model.id2name(int(i), "actuator") for i in self._arm_indices().actuators]
 
-    # Fancy indexing (by an index array) returns a new array: no .copy() after it.
+    # The ``*_select`` indices are slices where they can be: what is returned is copied
+    # (``np.array``), since a slice is a view into the live simulation.
     def head_position(self) -> np.ndarray:
         """Head site position (x, y, z) in metres, world frame."""
         return self._raw_data.site_xpos[self._arm_indices().head_site].copy()
@@ -213,15 +239,15 @@ class ArmPhysicsMixin:
         past 180 (no wrap), see :func:`continuous_attitude_deg`."""
         indices, data = self._arm_indices(), self._raw_data
         xmat = data.xmat[indices.head_body]  # row-major 3x3; column 2 = head axis
-        return _continuous_attitude(math.atan2(xmat[2], xmat[8]), data.qpos[indices.qpos])
+        return _continuous_attitude(math.atan2(xmat[2], xmat[8]), data.qpos[indices.qpos_select])
 
     def joint_angles(self) -> np.ndarray:
         """The 18 joint angles (rad), atlas first; positive = ventral flexion."""
-        return self._raw_data.qpos[self._arm_indices().qpos]
+        return np.array(self._raw_data.qpos[self._arm_indices().qpos_select])
 
     def tendon_lengths(self) -> np.ndarray:
         """Current length of each actuated tendon (m), in action order."""
-        return self._raw_data.ten_length[self._arm_indices().tendons]
+        return np.array(self._raw_data.ten_length[self._arm_indices().tendon_select])
 
     def tendon_rest_lengths(self) -> np.ndarray:
         """Length of each tendon in the straight pose (m): the servo's zero contraction."""
@@ -230,34 +256,76 @@ class ArmPhysicsMixin:
     def tendon_contractions(self) -> np.ndarray:
         """How much each tendon is shorter than at rest (m)."""
         indices = self._arm_indices()
-        return indices.rest_lengths - self._raw_data.ten_length[indices.tendons]
+        return indices.rest_lengths - self._raw_data.ten_length[indices.tendon_select]
 
     def tendon_forces(self) -> np.ndarray:
         """Pull in each tendon (N, >= 0), in action order."""
-        return -self._raw_data.actuator_force[self._arm_indices().actuators]
+        return -self._raw_data.actuator_force[self._arm_indices().actuator_select]
 
     def tendon_max_forces(self) -> np.ndarray:
         """Largest pull of each tendon's actuator (N, > 0), in action order."""
-        return -self._raw_model.actuator_forcerange[self._arm_indices().actuators, 0]
+        return -self._raw_model.actuator_forcerange[self._arm_indices().actuator_select, 0]
+
+    def tendon_tensions(self) -> np.ndarray:
+        """Pull in each tendon as a fraction of its actuator's largest pull (0-1)."""
+        select = self._arm_indices().actuator_select
+        return self._raw_data.actuator_force[select] / self._raw_model.actuator_forcerange[select, 0]
 
     def arm_control(self) -> np.ndarray:
-        return self._raw_data.ctrl[self._arm_indices().actuators]
+        return np.array(self._raw_data.ctrl[self._arm_indices().actuator_select])
 
     def arm_control_range(self) -> np.ndarray:
         """(9, 2) low/high tendon contractions (m): the action spec's bounds."""
-        return self._raw_model.actuator_ctrlrange[self._arm_indices().actuators]
+        return np.array(self._raw_model.actuator_ctrlrange[self._arm_indices().actuator_select])
+
+    def arm_control_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(low, high) tendon contractions (m), read-only views where they can be: the
+        per-step action check reads these instead of copying the (9, 2) range."""
+        ctrlrange = self._raw_model.actuator_ctrlrange[self._arm_indices().actuator_select]
+        return ctrlrange[:, 0], ctrlrange[:, 1]
 
     def set_arm_control(self, action) -> None:
         """Write tendon contractions to the arm's actuators only (a robot may have others)."""
-        self._raw_data.ctrl[self._arm_indices().actuators] = action
+        self._raw_data.ctrl[self._arm_indices().actuator_select] = action
 
     def step(self, nstep: int = 1) -> None:
         """Step, but turn a divergence into a flag the task ends the episode on.
 
-        A divergence ends the episode, so it is logged once per episode: one line
-        with MuJoCo's own warnings and how many episodes have diverged so far."""
+        The same MuJoCo calls and the same invalid-state test (a MuJoCo warning count that
+        grew) as dm_control's ``Physics.step``, on the raw structs: its wrapper costs about
+        as much as the whole task's observation.  A divergence ends the episode, so it is
+        logged once per episode: one line with MuJoCo's own warnings and how many episodes
+        have diverged so far."""
         if self.divergence is not None:
             return
+        if not (self.legacy_step and self._warnings_cause_exception):
+            return self._checked_step(nstep)  # dm_control's own path, for its other settings
+        model, data, warnings = self._raw_model, self._raw_data, self._warnings
+        # MuJoCo's warning counts stay 0 until something goes wrong (a reset clears them), so
+        # mostly one test before and one after the step say that none grew.
+        before = warnings.copy() if warnings.any() else None
+        _MUJOCO_WARNINGS.active, _MUJOCO_WARNINGS.messages = True, []
+        try:
+            # dm_control's legacy step: mj_step1 of this state ran at the end of the last step.
+            if self._arm_indices().rk4:
+                mujoco_lib.mj_step(model, data, nstep)
+            else:
+                mujoco_lib.mj_step2(model, data)
+                if nstep > 1:
+                    mujoco_lib.mj_step(model, data, nstep - 1)
+            mujoco_lib.mj_step1(model, data)
+        finally:
+            _MUJOCO_WARNINGS.active = False
+        if not warnings.any():
+            return
+        new_warnings = warnings > (0 if before is None else before)
+        if new_warnings.any():
+            names = np.compress(new_warnings, list(mujoco_lib.mjtWarning.__members__))
+            self.divergence = _INVALID_STATE.format(warning_names=", ".join(names))
+            self._log_divergence(_MUJOCO_WARNINGS.messages)
+
+    def _checked_step(self, nstep: int) -> None:
+        """dm_control's ``Physics.step`` with the divergence turned into the flag."""
         _MUJOCO_WARNINGS.active, _MUJOCO_WARNINGS.messages = True, []
         try:
             super().step(nstep)
@@ -321,7 +389,7 @@ class QuadrupedPhysicsMixin(ArmPhysicsMixin):
         xmat = data.xmat[indices.head_body]  # head body; row-major: axis z = (2, 5, 8)
         hx, hy = self.heading()
         return _continuous_attitude(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8]),
-                                    data.qpos[indices.qpos])
+                                    data.qpos[indices.qpos_select])
 
     # Quadruped.
     def trunk_position(self) -> np.ndarray:

@@ -26,7 +26,8 @@ def load_tool(name):
 
 
 def summary(success, position, attitude, steps=300, kinds=("heldout", "heldout_moving", "track")):
-    run = {k: {"success_rate": success, "position_error_median": position, "attitude_error_median": attitude}
+    run = {k: {"success_rate": success, "precise_success_rate": success / 2,
+               "position_error_median": position, "attitude_error_median": attitude}
            for k in kinds}
     return {"runs": {"curriculum": run, "baseline": dict(run), "lookup": dict(run)},
             "env_steps": {"curriculum": steps, "baseline": steps}}
@@ -63,7 +64,9 @@ def test_seeds_aggregation_is_exact_mean_min_max():
     assert list(agg["results"]) == ["curriculum", "baseline", "lookup"]
     assert agg["steps"]["curriculum"] == [300, 300, 300] and agg["steps"]["lookup"] == [None] * 3
     table = tool.format_table(agg)
-    assert "| curriculum | heldout | 25.0 [0.0, 50.0] | 0.300 [0.200, 0.400] | 15.0 [5.0, 30.0] |" in table
+    assert heldout["precise_success_rate"]["mean"] == 0.125
+    assert ("| curriculum | heldout | 25.0 [0.0, 50.0] | 12.5 [0.0, 25.0] | 0.300 [0.200, 0.400] | "
+            "15.0 [5.0, 30.0] |") in table
     assert "| lookup | track (2/3 seeds) |" in table
     assert "Seeds: 0, 1, 7" in table and "seed 1: 2.5, seed 7: -" in table and "curriculum 300" in table
     with pytest.raises(ValueError, match="no summaries"):

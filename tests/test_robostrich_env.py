@@ -415,3 +415,37 @@ def test_stored_starts_begin_lesson3_episodes_where_a_stored_input_holds_the_arm
         robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(stored_starts=0.5))
     with pytest.raises(ValueError, match="start_inputs must be a non-empty"):
         robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(stored_starts=0.5, start_inputs=[np.nan] * 9))
+
+
+@pytest.mark.parametrize("domain", ["robostrich", "robostrich_a1"])
+def test_the_arm_physics_steps_exactly_as_dm_controls_physics_step(domain):
+    """The per-step path calls MuJoCo directly (dm_control's wrapper cost as much as the
+    task's observation): same states, bit for bit, as dm_control's own Physics.step, and a
+    diverging step is still caught by dm_control's test (a grown MuJoCo warning count)."""
+    from dm_control.mujoco import engine
+    ours = robostrich_suite.load(domain, "lesson2", task_kwargs=dict(random=0)).physics
+    reference = ours.copy(share_model=False)
+    inputs = np.random.default_rng(0).uniform(*ours.arm_control_range().T, size=(60, 9))
+    for action in inputs:
+        for physics in (ours, reference):
+            physics.set_arm_control(action)
+        ours.step(4)
+        engine.Physics.step(reference, 4)
+        np.testing.assert_array_equal(ours.data.qpos, reference.data.qpos)
+        np.testing.assert_array_equal(ours.data.qacc, reference.data.qacc)  # mj_step1/2 alike
+    assert ours.divergence is None
+    ours.data.qvel[3] = np.inf
+    ours.step(4)
+    assert "Physics state is invalid" in ours.divergence and "BADQ" in ours.divergence
+
+
+def test_per_step_index_slices_read_the_same_elements():
+    from robostrich_suite import physics as physics_lib
+    values = np.arange(20.0)
+    for ids in ([3, 4, 5], [17, 16, 15, 0 + 14], list(range(17, -1, -1)), [0, 2], [2, 0], [5, 9, 6], [4]):
+        select = physics_lib.as_slice(ids)
+        np.testing.assert_array_equal(values[select], values[ids])
+    assert isinstance(physics_lib.as_slice(list(range(17, -1, -1))), slice)
+    assert not isinstance(physics_lib.as_slice([5, 9, 6]), slice)
+    indices = robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(random=0)).physics._arm_indices()
+    assert isinstance(indices.qpos_select, slice) and isinstance(indices.actuator_select, slice)

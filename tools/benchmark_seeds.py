@@ -20,6 +20,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 LABELS = ("curriculum", "baseline", "lookup")
 KINDS = ("heldout", "heldout_moving", "track")
 METRICS = (("success_rate", "success rate (%)", 100.0, "{:.1f}"),
+           ("precise_success_rate", "success within 1 cm and 2 deg (%)", 100.0, "{:.1f}"),
            ("position_error_median", "median position error (m)", 1.0, "{:.3f}"),
            ("attitude_error_median", "median attitude error (deg)", 1.0, "{:.1f}"))
 TIMING_FILE = "benchmark_timing.json"  # wall-clock of the seed's training command, beside its summary

@@ -22,6 +22,7 @@ the episode (discount 0) and is logged, instead of raising from the step.
 from __future__ import annotations
 
 import collections
+import math
 
 import numpy as np
 from dm_control.suite import base
@@ -78,17 +79,23 @@ def check_time_limit(time_limit) -> float:
     return float(time_limit)
 
 
-def check_action(action: np.ndarray, control_range: np.ndarray) -> np.ndarray:
+def check_action(action: np.ndarray, control_range) -> np.ndarray:
     """Reject actions of the wrong shape or type and NaN/inf; clip the rest into
-    ``control_range`` ((n, 2) low/high)."""
-    action = validate_action(action, len(control_range))
-    finite = np.isfinite(action)
-    if not finite.all():
-        bad = np.flatnonzero(~finite).tolist()
-        raise ValueError(f"action has non-finite values at indices {bad}: {action}")
-    control_range = np.asarray(control_range)
-    # np.clip's result, without its per-call overhead (this runs every control step)
-    return np.minimum(np.maximum(action, control_range[:, 0]), control_range[:, 1])
+    ``control_range``: an (n, 2) low/high array, or the (low, high) pair
+    ``physics.arm_control_bounds()`` gives."""
+    low, high = (control_range[:, 0], control_range[:, 1]) if isinstance(control_range, np.ndarray) \
+        else control_range
+    action = validate_action(action, len(low))
+    # One dot product is finite when every entry is (and small enough that squares stay
+    # finite, which real tendon inputs are); only otherwise look at each entry.
+    if not math.isfinite(action.dot(action)):
+        finite = np.isfinite(action)
+        if not finite.all():
+            bad = np.flatnonzero(~finite).tolist()
+            raise ValueError(f"action has non-finite values at indices {bad}: {action}")
+    # np.clip's result, in place on validate_action's copy (this runs every control step)
+    np.maximum(action, low, out=action)
+    return np.minimum(action, high, out=action)
 
 
 class Reach(base.Task):
@@ -168,7 +175,7 @@ class Reach(base.Task):
         self.desired_attitude = float(desired_attitude)
         self.weights = weights or rewards.RewardWeights()
         self.target_axes = tuple(target_axes)
-        self._target_axes_index = list(self.target_axes)
+        self._target_axes_index = physics_lib.as_slice(self.target_axes)
         if isinstance(randomization, dict):
             randomization = randomization_lib.DomainRandomization(**randomization)
         self.randomizer = (randomization_lib.Randomizer(randomization)
@@ -259,7 +266,7 @@ class Reach(base.Task):
                                   name="\t".join(physics.tendon_names()))
 
     def before_step(self, action, physics):
-        physics.set_arm_control(check_action(action, physics.arm_control_range()))
+        physics.set_arm_control(check_action(action, physics.arm_control_bounds()))
 
     def after_step(self, physics):
         # Remember where the arm is for the next episode of a "continue" lesson.
@@ -281,7 +288,8 @@ class Reach(base.Task):
         return physics.head_position()[self._target_axes_index]
 
     def position_error(self, physics) -> float:
-        return float(np.linalg.norm(self.target_position - self.head_xz(physics)))
+        to_target = self.target_position - self.head_xz(physics)
+        return math.sqrt(to_target.dot(to_target))  # np.linalg.norm's own formula, without its checks
 
     def attitude_error(self, physics) -> float:
         """Signed head attitude error in degrees (positive = head pitched down), in [-180, 180)."""
@@ -334,11 +342,11 @@ class Reach(base.Task):
         obs["target_position"] = self.target_position.copy()
         obs["to_target"] = self.target_position - head
         attitude = physics.head_attitude()  # once: it is the costliest measurement of a step
-        attitude_error = float(physics_lib.attitude_error_deg(attitude, self.desired_attitude))
-        obs["attitude_error"] = np.array([np.radians(attitude_error)])
-        obs["head_attitude"] = np.array([np.radians(attitude)])
+        attitude_error = physics_lib.attitude_error_deg(attitude, self.desired_attitude)
+        obs["attitude_error"] = np.array([math.radians(attitude_error)])
+        obs["head_attitude"] = np.array([math.radians(attitude)])
         obs["tendon_contraction"] = physics.tendon_contractions()
-        obs["tendon_tension"] = physics.tendon_forces() / physics.tendon_max_forces()
+        obs["tendon_tension"] = physics.tendon_tensions()
         return obs
 
     def get_reward(self, physics):
