@@ -161,8 +161,13 @@ def map_opt_state(opt_state, params: Mapping, obs_map: ObservationMap):
 
 def transfer_state(source, fresh, obs_map: ObservationMap):
     """A TrainingState for the target: `source`'s networks, optimisers and temperature mapped, `fresh`'s
-    RNG key and update counter (both TrainingStates, numpy leaves)."""
+    RNG key and update counter (both TrainingStates, numpy leaves). A target that keeps a policy
+    average starts it from the source's average, or from its policy where it kept none."""
+    source_average = getattr(source, "average_policy_params", None)
+    average = None if fresh.average_policy_params is None else map_params(
+        source.policy_params if source_average is None else source_average, obs_map)
     return fresh._replace(
+        average_policy_params=average,
         policy_params=map_params(source.policy_params, obs_map),
         q_params=map_params(source.q_params, obs_map),
         target_q_params=map_params(source.target_q_params, obs_map),

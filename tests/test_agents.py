@@ -7,7 +7,7 @@ from dm_env import specs
 from agents.actors import ActionAdapter, Actor
 from agents.replay import ObservationFlattener, ReplayBuffer
 from agents.sac.config import SACConfig
-from agents.sac.learning import SACLearner, Transitions
+from agents.sac.learning import SACLearner, TrainingState, Transitions
 from agents.sac.networks import make_networks, tanh_gaussian_log_prob
 
 OBS, ACT = 6, 3
@@ -64,6 +64,33 @@ def test_scan_of_k_updates_equals_k_single_updates():
         b.step(Transitions(*(x[i:i + 1] for x in batches)))
     for x, y in zip(leaves(a.state), leaves(b.state), strict=True):
         np.testing.assert_allclose(x, y, rtol=1e-5, atol=1e-6)
+
+
+def test_policy_average_leaves_training_alone_and_evaluates_the_moving_average():
+    import dataclasses
+    averaged_config = dataclasses.replace(TINY, policy_average=0.25)
+    plain, averaged = make_learner(seed=6), make_learner(seed=6, config=averaged_config)
+    start = leaves(averaged.policy_params)
+    one = random_batch(1, 32, seed=3)
+    plain.step(one)
+    averaged.step(one)
+    # the agent explores and learns with its current policy: bit for bit the plain learner's state
+    for x, y in zip(leaves(plain.state[:9]), leaves(averaged.state[:9]), strict=True):
+        np.testing.assert_array_equal(x, y)
+    assert plain.evaluation_params is plain.policy_params and plain.state.average_policy_params is None
+    # after one update the average is 3/4 of where the policy started and 1/4 of where it went
+    for avg, p0, p1 in zip(leaves(averaged.evaluation_params), start, leaves(averaged.policy_params), strict=True):
+        np.testing.assert_allclose(avg, 0.75 * p0 + 0.25 * p1, rtol=1e-6, atol=1e-7)
+    assert any(not np.array_equal(a, p) for a, p in zip(leaves(averaged.evaluation_params),
+                                                      leaves(averaged.policy_params)))
+    with pytest.raises(ValueError, match="lacks a policy average"):
+        averaged.set_state(plain.get_state())  # e.g. a checkpoint of a run without one
+    # a checkpoint pickled before the field existed unpickles through the 9 values it has
+    old = TrainingState(*plain.get_state()[:9])
+    assert old.average_policy_params is None
+    plain.set_state(old)
+    with pytest.raises(ValueError, match="policy_average must be a rate"):
+        SACConfig(policy_average=1.0)
 
 
 def test_temperature_rises_when_entropy_is_below_target():

@@ -63,4 +63,6 @@ class SACBuilder:
 
     @staticmethod
     def make_eval_actor(loop: EnvironmentLoop) -> Actor:
-        return Actor(loop.learner.networks, loop.actor.adapter, loop.learner.policy_params, deterministic=True)
+        """The deterministic policy a trained agent is judged by (its average, if it keeps one)."""
+        return Actor(loop.learner.networks, loop.actor.adapter, loop.learner.evaluation_params,
+                     deterministic=True)

@@ -74,6 +74,12 @@ class SACConfig:
     # critic's mean |Q|, as TD3+BC): keeps a residual policy at its base unless the critic
     # clearly prefers a correction (0 = off, plain SAC's actor loss; 0.4 is TD3+BC's alpha = 2.5).
     action_anchor: float = 0.0
+    # Evaluate (and deploy) an exponential moving average of the policy's parameters, updated
+    # with this rate after every gradient step (0 = off: the last policy, as the paper). The
+    # agent still explores with its current policy, so training is unchanged bit for bit; the
+    # average smooths the update-to-update wobble that moves a held-out target in or out of
+    # the tolerance from one evaluation to the next.
+    policy_average: float = 0.0
 
     # What a field was, in effect, for checkpoints written before it existed: their fingerprints
     # lack it, and `from_dict` fills it in so that they still load, resume and compare equal.
@@ -105,6 +111,8 @@ class SACConfig:
                              "(pass her_ratio=0, --her-ratio 0)")
         if not np.isfinite(self.target_entropy_per_action):
             raise ValueError(f"target_entropy_per_action must be finite, got {self.target_entropy_per_action}")
+        if not 0.0 <= self.policy_average < 1.0:
+            raise ValueError(f"policy_average must be a rate in [0, 1) (0 = off), got {self.policy_average}")
         if not (np.isfinite(self.action_anchor) and self.action_anchor >= 0):
             raise ValueError(f"action_anchor must be a finite weight >= 0, got {self.action_anchor}")
         if self.min_replay_size > self.max_replay_size:
@@ -147,7 +155,7 @@ class SACConfig:
                       reward_scale=1.0, critic_layer_norm=False, her_ratio=0.0, her_lessons=(),
                       her_level_goals=False, relabel_rewards=False,
                       residual_scale=0.0,
-                      action_anchor=0.0)
+                      action_anchor=0.0, policy_average=0.0)
         values.update(overrides)
         return cls(**values)
 

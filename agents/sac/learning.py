@@ -5,7 +5,7 @@ single `lax.scan`, so Python is entered once per call, not once per update.
 """
 import dataclasses
 import functools
-from typing import NamedTuple
+from typing import NamedTuple, Optional
 
 import jax
 import jax.numpy as jnp
@@ -27,6 +27,9 @@ class TrainingState(NamedTuple):
     alpha_opt_state: tuple
     key: jnp.ndarray
     steps: jnp.ndarray  # number of gradient updates done
+    # Exponential moving average of policy_params (SACConfig.policy_average > 0), else None;
+    # a default so that checkpoints written before it existed still unpickle.
+    average_policy_params: Optional[dict] = None
 
 
 def make_optimizers(config: SACConfig):
@@ -51,6 +54,8 @@ def init_state(networks: SACNetworks, config: SACConfig, key) -> TrainingState:
         alpha_opt_state=alpha_opt.init(log_alpha),
         key=key,
         steps=jnp.zeros((), jnp.int32),
+        average_policy_params=(jax.tree_util.tree_map(jnp.copy, policy_params)
+                               if config.policy_average > 0 else None),
     )
 
 
@@ -104,8 +109,12 @@ def make_update_fn(networks: SACNetworks, config: SACConfig):
         log_alpha = optax.apply_updates(state.log_alpha, alpha_updates)
 
         target_q_params = optax.incremental_update(q_params, state.target_q_params, config.tau)
+        average_policy_params = state.average_policy_params
+        if average_policy_params is not None:
+            average_policy_params = optax.incremental_update(policy_params, average_policy_params,
+                                                             config.policy_average)
         new_state = TrainingState(policy_params, q_params, target_q_params, policy_opt_state, q_opt_state,
-                                  log_alpha, alpha_opt_state, key, state.steps + 1)
+                                  log_alpha, alpha_opt_state, key, state.steps + 1, average_policy_params)
         metrics = {"critic_loss": c_loss, "actor_loss": a_loss, "alpha_loss": t_loss,
                    "temperature": alpha, "entropy": -jnp.mean(log_prob), "q_mean": q_mean}
         return new_state, metrics
@@ -147,7 +156,15 @@ class SACLearner:
 
     @property
     def policy_params(self):
+        """What the agent explores with while it trains."""
         return self.state.policy_params
+
+    @property
+    def evaluation_params(self):
+        """What a trained agent is evaluated and deployed with: the moving average of the policy
+        (``SACConfig.policy_average``) where the config keeps one, else the policy itself."""
+        average = self.state.average_policy_params
+        return self.state.policy_params if average is None else average
 
     @property
     def num_updates(self) -> int:
@@ -160,6 +177,10 @@ class SACLearner:
     def set_state(self, state):
         ref = jax.tree_util.tree_structure(self.state)
         if jax.tree_util.tree_structure(state) != ref:
+            averaged = (self.state.average_policy_params is not None, state.average_policy_params is not None)
+            if averaged[0] != averaged[1]:
+                raise ValueError("learner state in checkpoint does not match this learner's structure: it "
+                                 f"{'has' if averaged[1] else 'lacks'} a policy average (policy_average)")
             raise ValueError("learner state in checkpoint does not match this learner's structure")
         for a, b in zip(jax.tree_util.tree_leaves(self.state), jax.tree_util.tree_leaves(state)):
             if np.shape(a) != np.shape(b):
