@@ -191,3 +191,14 @@ def test_train_from_a_frame_checkpoint_end_to_end(source, tmp_path):
     other = call("robostrich-train", "--domain", "robostrich_a1", "--init-from", out / "baseline" / "checkpoint.pkl",
                  "--steps", "600", "--out", out, "--resume", "--layout", "paper", *TINY_ARGS)
     assert_user_error(other, "did not start from --init-from")
+
+
+def test_a_target_that_keeps_a_policy_average_starts_it_at_the_transferred_policy(source, tmp_path):
+    import dataclasses
+    run = CurriculumRun(A1_PLAN, dataclasses.replace(TINY, policy_average=0.01), 1, str(tmp_path))
+    transfer.initialize(run, source[1])  # the source kept no average: its policy is the start
+    state = run.loop.learner.state
+    for average, policy in zip(jax.tree_util.tree_leaves(state.average_policy_params),
+                               jax.tree_util.tree_leaves(state.policy_params), strict=True):
+        np.testing.assert_array_equal(average, policy)
+    assert len(jax.tree_util.tree_leaves(state.policy_params)) > 0
