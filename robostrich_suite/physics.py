@@ -279,8 +279,9 @@ class ArmPhysicsMixin:
         return np.array(self._raw_model.actuator_ctrlrange[self._arm_indices().actuator_select])
 
     def arm_control_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """(low, high) tendon contractions (m), read-only views where they can be: the
-        per-step action check reads these instead of copying the (9, 2) range."""
+        """(low, high) tendon contractions (m) for reading only: where the actuators are
+        consecutive these are views into the model, which the per-step action check reads
+        instead of copying the (9, 2) range."""
         ctrlrange = self._raw_model.actuator_ctrlrange[self._arm_indices().actuator_select]
         return ctrlrange[:, 0], ctrlrange[:, 1]
 
