@@ -68,8 +68,9 @@ def test_scan_of_k_updates_equals_k_single_updates():
 
 def test_policy_average_leaves_training_alone_and_evaluates_the_moving_average():
     import dataclasses
+    plain_config = dataclasses.replace(TINY, policy_average=0.0)  # the paper's: judge the last policy
     averaged_config = dataclasses.replace(TINY, policy_average=0.25)
-    plain, averaged = make_learner(seed=6), make_learner(seed=6, config=averaged_config)
+    plain, averaged = make_learner(seed=6, config=plain_config), make_learner(seed=6, config=averaged_config)
     start = leaves(averaged.policy_params)
     one = random_batch(1, 32, seed=3)
     plain.step(one)

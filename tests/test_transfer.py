@@ -193,12 +193,21 @@ def test_train_from_a_frame_checkpoint_end_to_end(source, tmp_path):
     assert_user_error(other, "did not start from --init-from")
 
 
-def test_a_target_that_keeps_a_policy_average_starts_it_at_the_transferred_policy(source, tmp_path):
+def test_a_target_that_keeps_a_policy_average_starts_it_at_the_source_s(source, tmp_path):
     import dataclasses
+    source_state = jax.tree_util.tree_map(np.asarray, source[0].loop.learner.state)
+    assert source_state.average_policy_params is not None  # TINY keeps the default average
     run = CurriculumRun(A1_PLAN, dataclasses.replace(TINY, policy_average=0.01), 1, str(tmp_path))
-    transfer.initialize(run, source[1])  # the source kept no average: its policy is the start
-    state = run.loop.learner.state
-    for average, policy in zip(jax.tree_util.tree_leaves(state.average_policy_params),
-                               jax.tree_util.tree_leaves(state.policy_params), strict=True):
-        np.testing.assert_array_equal(average, policy)
-    assert len(jax.tree_util.tree_leaves(state.policy_params)) > 0
+    obs_map = transfer.ObservationMap.between(source[0].loop.flattener.describe(), run.loop.flattener.describe(),
+                                              *transfer.correspondence("robostrich", "robostrich_a1"))
+    fresh = run.loop.learner.get_state()
+    for source_average in (source_state.average_policy_params, None):  # None: paper SAC, older runs
+        state = transfer.transfer_state(source_state._replace(average_policy_params=source_average), fresh, obs_map)
+        expected = state.policy_params if source_average is None else transfer.map_params(source_average, obs_map)
+        for a, b in zip(jax.tree_util.tree_leaves(state.average_policy_params),
+                        jax.tree_util.tree_leaves(expected), strict=True):
+            np.testing.assert_array_equal(a, b)
+    assert not all(np.array_equal(a, b) for a, b in zip(jax.tree_util.tree_leaves(source_state.average_policy_params),
+                                                      jax.tree_util.tree_leaves(source_state.policy_params)))
+    plain = transfer.transfer_state(source_state, fresh._replace(average_policy_params=None), obs_map)
+    assert plain.average_policy_params is None  # a target without an average keeps none

@@ -78,13 +78,14 @@ class SACConfig:
     # with this rate after every gradient step (0 = off: the last policy, as the paper). The
     # agent still explores with its current policy, so training is unchanged bit for bit; the
     # average smooths the update-to-update wobble that moves a held-out target in or out of
-    # the tolerance from one evaluation to the next.
-    policy_average: float = 0.0
+    # the tolerance from one evaluation to the next: 1e-4 (the last ~10k updates) raised
+    # held-out success from 93.2 to 96.0 % on the same 4 training runs (docs/learning.md).
+    policy_average: float = 1e-4
 
     # What a field was, in effect, for checkpoints written before it existed: their fingerprints
     # lack it, and `from_dict` fills it in so that they still load, resume and compare equal.
     LEGACY_VALUES: ClassVar[dict] = {"her_lessons": (), "target_entropy_per_action": -1.0,
-                                     "her_level_goals": False}
+                                     "her_level_goals": False, "policy_average": 0.0}
     # Fields that name lesson tasks (tuples here, lists in a fingerprint).
     LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons")
 
