@@ -91,11 +91,12 @@ def run_files(run_dir: str) -> Tuple[str, str, str]:
             os.path.join(run_dir, "evals.jsonl"))
 
 
-def check_lesson_names(plan, config: SACConfig, arm_domains) -> None:
+def check_lesson_names(plan, config: SACConfig, layout: Optional[str] = None) -> None:
     """ValueError naming the field if a per-lesson setting names a task the plan's domains lack:
     a misspelt lesson would silently turn its setting off (dm_control's tasks have no goal reward,
-    so HER does not apply there; a per-lesson discount applies to any plan). `arm_domains`: the
-    plan's arm Domains."""
+    so HER does not apply there; a per-lesson discount applies to any plan). An unknown `layout`,
+    or one on a dm_control plan, fails here too."""
+    arm_domains = {d for d in (as_domain(lesson.domain, layout) for lesson in plan) if d.is_arm}
     named = {"her_lessons": config.her_lessons if config.her_ratio > 0 and arm_domains else (),
              "long_horizon_lessons": config.long_horizon_lessons}
     known = {lesson.task for lesson in plan} | {task for domain in arm_domains for task in domain.tasks()}
@@ -131,9 +132,7 @@ class CurriculumRun:
         self.task_kwargs = dict(task_kwargs or {})
         self.layout = layout
         self.init_from = init_from
-        # an unknown layout or a layout on dm_control fails here, not mid-run
-        arm_domains = {d for d in (as_domain(lesson.domain, layout) for lesson in plan) if d.is_arm}
-        check_lesson_names(plan, config, arm_domains)
+        check_lesson_names(plan, config, layout)  # and an unknown layout fails here, not mid-run
         self.plan = list(plan)
         self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
         self.checkpoint_every = int(checkpoint_every)

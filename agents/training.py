@@ -458,7 +458,7 @@ def main(argv=None):
     for lesson in plan:  # a typo fails now, not after the first lessons have trained
         Domain(lesson.domain).check_task(lesson.task)
     check_task_kwargs(plan, args.layout, args.task_kwargs)
-    check_lesson_names(plan, config, {d for d in (Domain(l.domain, args.layout) for l in plan) if d.is_arm})
+    check_lesson_names(plan, config, args.layout)
     heldout_task = args.heldout_task or domain.heldout_task(final.task)
     track_task = domain.track_task(args.track_task)
     run_plans = {"curriculum": plan}

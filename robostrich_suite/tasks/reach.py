@@ -79,12 +79,10 @@ def check_time_limit(time_limit) -> float:
     return float(time_limit)
 
 
-def check_action(action: np.ndarray, control_range) -> np.ndarray:
-    """Reject actions of the wrong shape or type and NaN/inf; clip the rest into
-    ``control_range``: an (n, 2) low/high array, or the (low, high) pair
-    ``physics.arm_control_bounds()`` gives."""
-    low, high = (control_range[:, 0], control_range[:, 1]) if isinstance(control_range, np.ndarray) \
-        else control_range
+def check_action(action: np.ndarray, bounds) -> np.ndarray:
+    """Reject actions of the wrong shape or type and NaN/inf; clip the rest into ``bounds``,
+    the (low, high) arrays ``physics.arm_control_bounds()`` gives."""
+    low, high = bounds
     action = validate_action(action, len(low))
     # One dot product is finite when every entry is (and small enough that squares stay
     # finite, which real tendon inputs are); only otherwise look at each entry.
@@ -212,7 +210,7 @@ class Reach(base.Task):
         evaluation's moving starts do; the episode's clock then starts at 0.  A divergence
         while settling leaves the fixed pose (and is logged like any other)."""
         inputs = self.start_inputs[self.random.randint(len(self.start_inputs))]
-        physics.set_arm_control(check_action(inputs, physics.arm_control_range()))
+        physics.set_arm_control(check_action(inputs, physics.arm_control_bounds()))
         physics.step(int(round(STORED_START_SETTLE_TIME / physics.timestep())))
         if physics.divergence is not None:
             physics.reset()
