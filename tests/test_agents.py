@@ -69,7 +69,7 @@ def test_scan_of_k_updates_equals_k_single_updates():
 def test_policy_average_leaves_training_alone_and_evaluates_the_moving_average():
     import dataclasses
     plain_config = dataclasses.replace(TINY, policy_average=0.0)  # the paper's: judge the last policy
-    averaged_config = dataclasses.replace(TINY, policy_average=0.25)
+    averaged_config = dataclasses.replace(TINY, policy_average=0.25, policy_average_fraction=0.0)
     plain, averaged = make_learner(seed=6, config=plain_config), make_learner(seed=6, config=averaged_config)
     start = leaves(averaged.policy_params)
     one = random_batch(1, 32, seed=3)
@@ -92,6 +92,31 @@ def test_policy_average_leaves_training_alone_and_evaluates_the_moving_average()
     plain.set_state(old)
     with pytest.raises(ValueError, match="policy_average must be a rate"):
         SACConfig(policy_average=1.0)
+
+
+def test_early_on_the_policy_average_spans_a_fraction_of_the_updates_so_far():
+    """With policy_average_fraction f the rate after n updates is max(policy_average, 1/(1 + f n)):
+    a short run's average is of its recent policies, not mostly of its random initial one."""
+    import dataclasses
+    config = dataclasses.replace(TINY, policy_average=0.25, policy_average_fraction=0.5)
+    learner = make_learner(seed=6, config=config)
+    policies = [leaves(learner.policy_params)]
+    for seed in (3, 4, 5):
+        learner.step(random_batch(1, 32, seed=seed))
+        policies.append(leaves(learner.policy_params))
+    # rates 1/1.5, 1/2, 1/2.5: all still above the floor policy_average = 0.25
+    expected = policies[0]
+    for rate, policy in zip((1 / 1.5, 1 / 2.0, 1 / 2.5), policies[1:]):
+        expected = [(1 - rate) * e + rate * p for e, p in zip(expected, policy)]
+    for avg, e in zip(leaves(learner.evaluation_params), expected, strict=True):
+        np.testing.assert_allclose(avg, e, rtol=1e-5, atol=1e-6)
+    # a long run ends on policy_average itself: 1 / (1 + 0.1 * 1e6) < 1e-4
+    from agents.sac.learning import average_rate
+    assert float(average_rate(SACConfig(), 1_000_000)) == pytest.approx(1e-4)
+    assert float(average_rate(SACConfig(), 15_000)) == pytest.approx(1 / 1501)
+    assert average_rate(dataclasses.replace(SACConfig(), policy_average_fraction=0.0), 10) == 1e-4
+    with pytest.raises(ValueError, match="policy_average_fraction must be in"):
+        SACConfig(policy_average_fraction=-0.1)
 
 
 def test_temperature_rises_when_entropy_is_below_target():

@@ -59,6 +59,16 @@ def init_state(networks: SACNetworks, config: SACConfig, key) -> TrainingState:
     )
 
 
+def average_rate(config: SACConfig, updates):
+    """The policy average's rate after ``updates`` gradient steps (``SACConfig.policy_average``
+    and ``policy_average_fraction``): at least ``policy_average``, and early on about
+    1 / (fraction of the updates so far), so that a short run's average is of its recent
+    policies, not of its random initial one."""
+    if config.policy_average_fraction == 0.0:
+        return config.policy_average
+    return jnp.maximum(config.policy_average, 1.0 / (1.0 + config.policy_average_fraction * updates))
+
+
 def make_update_fn(networks: SACNetworks, config: SACConfig):
     """Returns update(state, batch) -> (state, metrics) for ONE gradient step (not jitted)."""
     policy_opt, q_opt, alpha_opt = make_optimizers(config)
@@ -111,8 +121,8 @@ def make_update_fn(networks: SACNetworks, config: SACConfig):
         target_q_params = optax.incremental_update(q_params, state.target_q_params, config.tau)
         average_policy_params = state.average_policy_params
         if average_policy_params is not None:
-            average_policy_params = optax.incremental_update(policy_params, average_policy_params,
-                                                             config.policy_average)
+            average_policy_params = optax.incremental_update(
+                policy_params, average_policy_params, average_rate(config, state.steps + 1))
         new_state = TrainingState(policy_params, q_params, target_q_params, policy_opt_state, q_opt_state,
                                   log_alpha, alpha_opt_state, key, state.steps + 1, average_policy_params)
         metrics = {"critic_loss": c_loss, "actor_loss": a_loss, "alpha_loss": t_loss,
