@@ -202,92 +202,93 @@ class ArmPhysicsMixin:
     episodes_started: int = 0
     episodes_diverged: int = 0
 
-    # Indices are looked up once per model.  dm_control swaps the model only through
-    # ``_reload_from_data`` (construction, reload, copy, unpickling), which forgets them
-    # and binds the raw ``mujoco`` structs: the per-step accessors read those directly,
-    # skipping dm_control's wrapper properties (a Python call per field read).
+    # Indices are looked up once per model, when dm_control binds it: it swaps the model only
+    # through ``_reload_from_data`` (construction, reload, copy, unpickling).  The per-step
+    # accessors read them, and the raw ``mujoco`` structs, as plain attributes: dm_control's
+    # wrapper properties and a method call per read cost about as much as the task's work.
+    _indices: ArmIndices
+
     def _reload_from_data(self, data):
-        self.__dict__["_arm_index_cache"] = None
         super()._reload_from_data(data)
         self.__dict__["_raw_model"], self.__dict__["_raw_data"] = data.model.ptr, data.ptr
+        self.__dict__["_indices"] = arm_indices(self.model)
 
-    def _arm_indices(self) -> ArmIndices:
-        indices = self.__dict__.get("_arm_index_cache")
-        if indices is None:
-            indices = self.__dict__["_arm_index_cache"] = arm_indices(self.model)
-        return indices
+    @property
+    def arm_indices(self) -> ArmIndices:
+        """Where the arm sits in this model (:func:`arm_indices`)."""
+        return self._indices
 
     def arm_joint_names(self) -> list[str]:
-        return [self.model.id2name(int(j), "joint") for j in self._arm_indices().joints]
+        return [self.model.id2name(int(j), "joint") for j in self._indices.joints]
 
     def tendon_names(self) -> list[str]:
-        return [self.model.id2name(int(i), "actuator") for i in self._arm_indices().actuators]
+        return [self.model.id2name(int(i), "actuator") for i in self._indices.actuators]
 
     # The ``*_select`` indices are slices where they can be: what is returned is copied
     # (``np.array``), since a slice is a view into the live simulation.
     def head_position(self) -> np.ndarray:
         """Head site position (x, y, z) in metres, world frame."""
-        return self._raw_data.site_xpos[self._arm_indices().head_site].copy()
+        return self._raw_data.site_xpos[self._indices.head_site].copy()
 
     def head_velocity(self) -> np.ndarray:
         """Head site linear velocity (x, y, z) in m/s, world frame."""
-        adr = self._arm_indices().head_velocity
+        adr = self._indices.head_velocity
         return self._raw_data.sensordata[adr:adr + 3].copy()
 
     def head_attitude(self) -> float:
         """Head attitude in degrees: 90 = head parallel to the ground (paper Fig. 2B); continuous
         past 180 (no wrap), see :func:`continuous_attitude_deg`."""
-        indices, data = self._arm_indices(), self._raw_data
+        indices, data = self._indices, self._raw_data
         xmat = data.xmat[indices.head_body]  # row-major 3x3; column 2 = head axis
         return _continuous_attitude(math.atan2(xmat[2], xmat[8]), data.qpos[indices.qpos_select])
 
     def joint_angles(self) -> np.ndarray:
         """The 18 joint angles (rad), atlas first; positive = ventral flexion."""
-        return np.array(self._raw_data.qpos[self._arm_indices().qpos_select])
+        return np.array(self._raw_data.qpos[self._indices.qpos_select])
 
     def tendon_lengths(self) -> np.ndarray:
         """Current length of each actuated tendon (m), in action order."""
-        return np.array(self._raw_data.ten_length[self._arm_indices().tendon_select])
+        return np.array(self._raw_data.ten_length[self._indices.tendon_select])
 
     def tendon_rest_lengths(self) -> np.ndarray:
         """Length of each tendon in the straight pose (m): the servo's zero contraction."""
-        return self._arm_indices().rest_lengths
+        return self._indices.rest_lengths
 
     def tendon_contractions(self) -> np.ndarray:
         """How much each tendon is shorter than at rest (m)."""
-        indices = self._arm_indices()
+        indices = self._indices
         return indices.rest_lengths - self._raw_data.ten_length[indices.tendon_select]
 
     def tendon_forces(self) -> np.ndarray:
         """Pull in each tendon (N, >= 0), in action order."""
-        return -self._raw_data.actuator_force[self._arm_indices().actuator_select]
+        return -self._raw_data.actuator_force[self._indices.actuator_select]
 
     def tendon_max_forces(self) -> np.ndarray:
         """Largest pull of each tendon's actuator (N, > 0), in action order."""
-        return -self._raw_model.actuator_forcerange[self._arm_indices().actuator_select, 0]
+        return -self._raw_model.actuator_forcerange[self._indices.actuator_select, 0]
 
     def tendon_tensions(self) -> np.ndarray:
         """Pull in each tendon as a fraction of its actuator's largest pull (0-1)."""
-        select = self._arm_indices().actuator_select
+        select = self._indices.actuator_select
         return self._raw_data.actuator_force[select] / self._raw_model.actuator_forcerange[select, 0]
 
     def arm_control(self) -> np.ndarray:
-        return np.array(self._raw_data.ctrl[self._arm_indices().actuator_select])
+        return np.array(self._raw_data.ctrl[self._indices.actuator_select])
 
     def arm_control_range(self) -> np.ndarray:
         """(9, 2) low/high tendon contractions (m): the action spec's bounds."""
-        return np.array(self._raw_model.actuator_ctrlrange[self._arm_indices().actuator_select])
+        return np.array(self._raw_model.actuator_ctrlrange[self._indices.actuator_select])
 
     def arm_control_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """(low, high) tendon contractions (m) for reading only: where the actuators are
         consecutive these are views into the model, which the per-step action check reads
         instead of copying the (9, 2) range."""
-        ctrlrange = self._raw_model.actuator_ctrlrange[self._arm_indices().actuator_select]
+        ctrlrange = self._raw_model.actuator_ctrlrange[self._indices.actuator_select]
         return ctrlrange[:, 0], ctrlrange[:, 1]
 
     def set_arm_control(self, action) -> None:
         """Write tendon contractions to the arm's actuators only (a robot may have others)."""
-        self._raw_data.ctrl[self._arm_indices().actuator_select] = action
+        self._raw_data.ctrl[self._indices.actuator_select] = action
 
     def step(self, nstep: int = 1) -> None:
         """Step, but turn a divergence into a flag the task ends the episode on.
@@ -303,12 +304,13 @@ class ArmPhysicsMixin:
             return self._checked_step(nstep)  # dm_control's own path, for its other settings
         model, data, warnings = self._raw_model, self._raw_data, self._warnings
         # MuJoCo's warning counts stay 0 until something goes wrong (a reset clears them), so
-        # mostly one test before and one after the step say that none grew.
-        before = warnings.copy() if warnings.any() else None
+        # mostly one test before and one after the step say that none grew (count_nonzero:
+        # a third of ndarray.any's cost on 8 numbers).
+        before = warnings.copy() if np.count_nonzero(warnings) else None
         _MUJOCO_WARNINGS.active, _MUJOCO_WARNINGS.messages = True, []
         try:
             # dm_control's legacy step: mj_step1 of this state ran at the end of the last step.
-            if self._arm_indices().rk4:
+            if self._indices.rk4:
                 mujoco_lib.mj_step(model, data, nstep)
             else:
                 mujoco_lib.mj_step2(model, data)
@@ -317,7 +319,7 @@ class ArmPhysicsMixin:
             mujoco_lib.mj_step1(model, data)
         finally:
             _MUJOCO_WARNINGS.active = False
-        if not warnings.any():
+        if not np.count_nonzero(warnings):
             return
         new_warnings = warnings > (0 if before is None else before)
         if new_warnings.any():
@@ -386,7 +388,7 @@ class QuadrupedPhysicsMixin(ArmPhysicsMixin):
     # Arm head.
     def head_attitude(self) -> float:
         """Head attitude (deg) in the trunk's heading plane: 0 up, 90 level, 180 down."""
-        indices, data = self._arm_indices(), self._raw_data
+        indices, data = self._indices, self._raw_data
         xmat = data.xmat[indices.head_body]  # head body; row-major: axis z = (2, 5, 8)
         hx, hy = self.heading()
         return _continuous_attitude(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8]),

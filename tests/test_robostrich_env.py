@@ -447,5 +447,5 @@ def test_per_step_index_slices_read_the_same_elements():
         np.testing.assert_array_equal(values[select], values[ids])
     assert isinstance(physics_lib.as_slice(list(range(17, -1, -1))), slice)
     assert not isinstance(physics_lib.as_slice([5, 9, 6]), slice)
-    indices = robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(random=0)).physics._arm_indices()
+    indices = robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(random=0)).physics.arm_indices
     assert isinstance(indices.qpos_select, slice) and isinstance(indices.actuator_select, slice)

@@ -51,7 +51,7 @@ def corresponding_states(count=4, seed=0):
     a1.reset()
     frame.reset()
     rng, spec = np.random.default_rng(seed), a1.action_spec()
-    a1_arm, frame_arm = a1.physics._arm_indices(), frame.physics._arm_indices()
+    a1_arm, frame_arm = a1.physics.arm_indices, frame.physics.arm_indices
     pairs = []
     for _ in range(count):
         for _ in range(15):

@@ -33,7 +33,7 @@ def _raw_model():
     physics = robostrich_a1.Physics.from_xml_string(robostrich_a1.get_model_and_assets()[0])
     physics.place_standing()
     data.qpos[:] = physics.data.qpos
-    arm = physics._arm_indices().actuators
+    arm = physics.arm_indices.actuators
     legs = physics._robot()["leg_actuators"]
     return model, data, arm, legs
 

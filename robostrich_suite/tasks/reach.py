@@ -106,6 +106,7 @@ class Reach(base.Task):
     _last_reached = None
     stored_starts = 0.0
     start_inputs = None
+    _head_reading = None
 
     def __init__(self, reward: str = "lesson2", initial_state: str = "fixed",
                  target_pool=None, position_tolerance: float = POSITION_TOLERANCE,
@@ -184,6 +185,7 @@ class Reach(base.Task):
 
     # --- episode structure -------------------------------------------------
     def initialize_episode(self, physics):
+        self._head_reading = None
         if self.target_sampling == "failures":  # before anything moves the physics
             self._count_previous_episode()
         if self.randomizer is not None:
@@ -264,10 +266,13 @@ class Reach(base.Task):
                                   name="\t".join(physics.tendon_names()))
 
     def before_step(self, action, physics):
+        self._head_reading = None
         physics.set_arm_control(check_action(action, physics.arm_control_bounds()))
 
     def after_step(self, physics):
-        # Remember where the arm is for the next episode of a "continue" lesson.
+        self._head_reading = None
+        # Remember where the arm is for the next episode of a "continue" lesson (always: a
+        # task may be switched to "continue" between episodes, as heldout_moving does).
         if physics.divergence is None:
             self._last_state = (physics.data.qpos.copy(), physics.data.qvel.copy(),
                                 physics.data.act.copy(), physics.arm_control())
@@ -284,6 +289,16 @@ class Reach(base.Task):
     # --- measurements ------------------------------------------------------
     def head_xz(self, physics) -> np.ndarray:
         return physics.head_position()[self._target_axes_index]
+
+    def _read_head(self, physics) -> tuple:
+        """(head x-z, attitude in deg) of the current state.  ``get_reward`` keeps its reading
+        for the ``get_observation`` that dm_control calls next in the same step, which uses it
+        once (a step or a new episode drops it): the attitude is a step's costliest reading."""
+        reading = self._head_reading
+        if reading is None:
+            return self.head_xz(physics), physics.head_attitude()
+        self._head_reading = None
+        return reading
 
     def position_error(self, physics) -> float:
         to_target = self.target_position - self.head_xz(physics)
@@ -330,7 +345,7 @@ class Reach(base.Task):
         radians, and tendon forces as a fraction of the actuator's limit.
         """
         obs = collections.OrderedDict()
-        head = self.head_xz(physics)
+        head, attitude = self._read_head(physics)
         obs["head_position"] = head
         obs["head_velocity"] = physics.head_velocity()[self._target_axes_index]
         joint_angles = physics.joint_angles()
@@ -339,7 +354,6 @@ class Reach(base.Task):
         obs["joint_angles"] = joint_angles
         obs["target_position"] = self.target_position.copy()
         obs["to_target"] = self.target_position - head
-        attitude = physics.head_attitude()  # once: it is the costliest measurement of a step
         attitude_error = physics_lib.attitude_error_deg(attitude, self.desired_attitude)
         obs["attitude_error"] = np.array([math.radians(attitude_error)])
         obs["head_attitude"] = np.array([math.radians(attitude)])
@@ -350,10 +364,12 @@ class Reach(base.Task):
     def get_reward(self, physics):
         if physics.divergence is not None:
             return -2.0 if self.reward_name == "lesson1" else -2.0 * self.weights.largest_penalty
-        error = self.position_error(physics)
+        head, attitude = self._head_reading = self._read_head(physics)
+        to_target = self.target_position - head
+        error = math.sqrt(to_target.dot(to_target))  # position_error's formula
         if self.reward_name == "lesson1":
             return rewards.lesson1_reward(error, self.position_tolerance)
-        return rewards.lesson2_reward(error, self.attitude_error(physics),
+        return rewards.lesson2_reward(error, physics_lib.attitude_error_deg(attitude, self.desired_attitude),
                                       self.position_tolerance, self.attitude_tolerance,
                                       self.weights)
 
@@ -404,7 +420,8 @@ class Track(Reach):
 
     def get_observation(self, physics):
         obs = super().get_observation(physics)
-        obs["position_error"] = np.array([self.position_error(physics)])
+        to_target = obs["to_target"]  # position_error's formula on the same reading
+        obs["position_error"] = np.array([math.sqrt(to_target.dot(to_target))])
         obs["target_index"] = np.array([float(self.target_index)])
         return obs
 
