@@ -119,6 +119,31 @@ def test_early_on_the_policy_average_spans_a_fraction_of_the_updates_so_far():
         SACConfig(policy_average_fraction=-0.1)
 
 
+def test_pre_tanh_penalty_pulls_the_policy_mean_out_of_saturation():
+    """A policy whose pre-tanh mean sits deep in the tanh's flat part (here pushed there by a
+    large output bias) gets almost no gradient from the critic; the penalty brings it back."""
+    import dataclasses
+    networks = make_networks(OBS, ACT, TINY.hidden_sizes)
+    batches = random_batch(8, 32, seed=4)
+    obs = batches.obs[0]
+
+    def mean_magnitude(config):
+        learner = SACLearner(networks, config, jax.random.PRNGKey(7))
+        params = jax.tree_util.tree_map(np.array, learner.policy_params)
+        params["mean"]["b"][:] = 3.0  # pre-tanh means near 3: tanh' = 0.01
+        learner.set_state(learner.get_state()._replace(policy_params=params))
+        for _ in range(5):
+            learner.step(batches)
+        mean, _ = networks.policy_apply(learner.policy_params, obs)
+        return float(np.mean(np.abs(mean)))
+
+    plain = mean_magnitude(dataclasses.replace(TINY, policy_average=0.0))
+    penalised = mean_magnitude(dataclasses.replace(TINY, policy_average=0.0, pre_tanh_penalty=1.0))
+    assert plain > 2.0 and penalised < plain - 0.2, (penalised, plain)  # measured: 2.51 and 2.14
+    with pytest.raises(ValueError, match="pre_tanh_penalty must be"):
+        SACConfig(pre_tanh_penalty=-1.0)
+
+
 def test_temperature_rises_when_entropy_is_below_target():
     config = SACConfig(**{**TINY.to_dict(), "target_entropy": 100.0, "hidden_sizes": (32, 32)})
     learner = make_learner(config=config)

@@ -74,6 +74,11 @@ class SACConfig:
     # critic's mean |Q|, as TD3+BC): keeps a residual policy at its base unless the critic
     # clearly prefers a correction (0 = off, plain SAC's actor loss; 0.4 is TD3+BC's alpha = 2.5).
     action_anchor: float = 0.0
+    # Weight of a penalty on the squared pre-tanh mean of the policy in the actor loss (the
+    # original SAC code's mean regulariser, 1e-3 there; 0 = off, plain SAC). A tendon whose
+    # mean sits deep in the tanh's saturation gets almost no gradient from the critic (seed 0's
+    # tendon 0 at 2.9: 1 - tanh^2 = 0.012); this pulls it back where the critic can move it.
+    pre_tanh_penalty: float = 0.0
     # Evaluate (and deploy) an exponential moving average of the policy's parameters, updated
     # with this rate after every gradient step (0 = off: the last policy, as the paper). The
     # agent still explores with its current policy, so training is unchanged bit for bit; the
@@ -125,6 +130,8 @@ class SACConfig:
         if not 0.0 <= self.policy_average_fraction <= 1.0:
             raise ValueError("policy_average_fraction must be in [0, 1] (0 = a plain moving average), "
                              f"got {self.policy_average_fraction}")
+        if not (np.isfinite(self.pre_tanh_penalty) and self.pre_tanh_penalty >= 0):
+            raise ValueError(f"pre_tanh_penalty must be a finite weight >= 0, got {self.pre_tanh_penalty}")
         if not (np.isfinite(self.action_anchor) and self.action_anchor >= 0):
             raise ValueError(f"action_anchor must be a finite weight >= 0, got {self.action_anchor}")
         if self.min_replay_size > self.max_replay_size:
@@ -167,7 +174,7 @@ class SACConfig:
                       reward_scale=1.0, critic_layer_norm=False, her_ratio=0.0, her_lessons=(),
                       her_level_goals=False, relabel_rewards=False,
                       residual_scale=0.0,
-                      action_anchor=0.0, policy_average=0.0)
+                      action_anchor=0.0, pre_tanh_penalty=0.0, policy_average=0.0)
         values.update(overrides)
         return cls(**values)
 

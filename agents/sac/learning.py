@@ -94,6 +94,9 @@ def make_update_fn(networks: SACNetworks, config: SACConfig):
             q_scale = jax.lax.stop_gradient(jnp.mean(jnp.abs(jnp.minimum(q1, q2)))) + 1e-6
             anchor = jnp.mean(networks.mode(policy_params, obs) ** 2)
             loss = loss + config.action_anchor * q_scale * anchor
+        if config.pre_tanh_penalty > 0:
+            mean, _ = networks.policy_apply(policy_params, obs)
+            loss = loss + config.pre_tanh_penalty * jnp.mean(mean ** 2)
         return loss, log_prob
 
     def alpha_loss(log_alpha, log_prob):
