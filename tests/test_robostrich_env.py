@@ -449,3 +449,24 @@ def test_per_step_index_slices_read_the_same_elements():
     assert not isinstance(physics_lib.as_slice([5, 9, 6]), slice)
     indices = robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(random=0)).physics.arm_indices
     assert isinstance(indices.qpos_select, slice) and isinstance(indices.actuator_select, slice)
+
+
+def test_reward_and_observation_read_the_state_they_are_asked_about():
+    """get_reward hands its head reading to the get_observation dm_control calls next (one
+    reading per step); a reward asked for again after the state moved reads the new state, and
+    the observation that uses the handed-over reading equals a freshly read one."""
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=0))
+    env.reset()
+    for _ in range(50):
+        env.step(np.full(9, 0.01))
+    task, physics = env.task, env.physics
+    bent = task.get_reward(physics)
+    with physics.reset_context():  # back to the straight start, no step taken
+        pass
+    straight = task.get_reward(physics)
+    handed_over = task.get_observation(physics)  # uses get_reward's reading
+    fresh = task.get_observation(physics)  # reads the head itself
+    assert straight != bent
+    for key in fresh:
+        np.testing.assert_array_equal(handed_over[key], fresh[key])
+    np.testing.assert_array_equal(fresh["head_position"], physics.head_position()[[0, 2]])

@@ -291,9 +291,10 @@ class Reach(base.Task):
         return physics.head_position()[self._target_axes_index]
 
     def _read_head(self, physics) -> tuple:
-        """(head x-z, attitude in deg) of the current state.  ``get_reward`` keeps its reading
-        for the ``get_observation`` that dm_control calls next in the same step, which uses it
-        once (a step or a new episode drops it): the attitude is a step's costliest reading."""
+        """(head x-z, attitude in deg) for ``get_observation``.  ``get_reward`` always reads the
+        head afresh and keeps its reading for the ``get_observation`` that dm_control calls next
+        in the same step, which uses it once (a step or a new episode drops it): the attitude is
+        a step's costliest reading."""
         reading = self._head_reading
         if reading is None:
             return self.head_xz(physics), physics.head_attitude()
@@ -364,7 +365,7 @@ class Reach(base.Task):
     def get_reward(self, physics):
         if physics.divergence is not None:
             return -2.0 if self.reward_name == "lesson1" else -2.0 * self.weights.largest_penalty
-        head, attitude = self._head_reading = self._read_head(physics)
+        head, attitude = self._head_reading = self.head_xz(physics), physics.head_attitude()
         to_target = self.target_position - head
         error = math.sqrt(to_target.dot(to_target))  # position_error's formula
         if self.reward_name == "lesson1":
