@@ -93,7 +93,7 @@ class SACConfig:
     # 1 / (1 + fraction * updates))) instead of keeping the initial policy's weight: with a
     # plain EMA at 1e-4, 15k updates (cartpole/swingup's 100k steps) leave 22 % of the
     # average at the random initial policy (275 against 866 by the last policy); 0 = the
-    # plain EMA.  Long runs are barely touched (~100k updates: the rate ends at ~1e-4 either way).
+    # plain EMA.  From 100k updates on the rate is policy_average itself (the arm's 479k-update runs).
     policy_average_fraction: float = 0.1
 
     # What a field was, in effect, for checkpoints written before it existed: their fingerprints
