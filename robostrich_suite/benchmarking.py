@@ -8,15 +8,29 @@ import numpy as np
 import robostrich_suite
 
 
+class EnvLoop:
+    """``robostrich_suite.load(domain, task)`` stepped with ``actions`` in turn, resets included;
+    each ``run`` continues where the last one stopped, so short timed rounds add up to episodes."""
+
+    def __init__(self, domain: str, task: str, actions: np.ndarray):
+        self.env = robostrich_suite.load(domain, task, task_kwargs=dict(random=0))
+        self.env.reset()
+        self.actions, self.count = actions, 0
+
+    def run(self, steps: int) -> float:
+        """Seconds for ``steps`` control steps."""
+        env, actions = self.env, self.actions
+        start = time.perf_counter()
+        for i in range(self.count, self.count + steps):
+            if env.step(actions[i % len(actions)]).last():
+                env.reset()
+        self.count += steps
+        return time.perf_counter() - start
+
+
 def env_steps_per_second(domain: str, task: str, steps: int, actions: np.ndarray) -> float:
     """Control steps per second of ``robostrich_suite.load(domain, task)``, resets included."""
-    env = robostrich_suite.load(domain, task, task_kwargs=dict(random=0))
-    env.reset()
-    start = time.perf_counter()
-    for i in range(steps):
-        if env.step(actions[i % len(actions)]).last():
-            env.reset()
-    return steps / (time.perf_counter() - start)
+    return steps / EnvLoop(domain, task, actions).run(steps)
 
 
 def random_actions(domain: str, task: str, count: int = 500, seed: int = 0) -> np.ndarray:

@@ -186,7 +186,7 @@ def test_env_benchmark_resets_its_raw_baseline_like_the_environment(capsys):
     raw = tool.RawLoop(actions, 250)
     raw.run(300)  # an episode of 250 control steps, then 50 of the next from the fixed start
     assert raw.data.time == pytest.approx(50 * 0.008)
-    wrapped = tool.EnvLoop("lesson2", actions)
+    wrapped = benchmarking.EnvLoop("robostrich", "lesson2", actions)
     wrapped.run(300)
     assert wrapped.env.physics.data.time == pytest.approx(50 * 0.008)
     np.testing.assert_array_equal(wrapped.env.physics.data.qpos, raw.data.qpos)  # the same episodes

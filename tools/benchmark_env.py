@@ -19,7 +19,6 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-import robostrich_suite  # noqa: E402
 from robostrich_suite import benchmarking, robostrich  # noqa: E402
 
 
@@ -48,24 +47,6 @@ class RawLoop:
         return time.perf_counter() - start
 
 
-class EnvLoop:
-    """``robostrich_suite.load("robostrich", task)`` stepped with the same actions, resets included."""
-
-    def __init__(self, task: str, actions: np.ndarray):
-        self.env = robostrich_suite.load("robostrich", task, task_kwargs=dict(random=0))
-        self.env.reset()
-        self.actions, self.count = actions, 0
-
-    def run(self, steps: int) -> float:
-        env, actions = self.env, self.actions
-        start = time.perf_counter()
-        for i in range(self.count, self.count + steps):
-            if env.step(actions[i % len(actions)]).last():
-                env.reset()
-        self.count += steps
-        return time.perf_counter() - start
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--steps", type=int, default=1000, help="control steps per round and loop")
@@ -74,7 +55,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     actions = benchmarking.random_actions("robostrich", args.task)
     raw = RawLoop(actions, benchmarking.episode_steps("robostrich", args.task))
-    wrapped = EnvLoop(args.task, actions)
+    wrapped = benchmarking.EnvLoop("robostrich", args.task, actions)
     raw.run(args.steps), wrapped.run(args.steps)  # warm caches and allocations
     raw_seconds, env_seconds = [], []
     for _ in range(args.rounds):

@@ -59,6 +59,11 @@ def validate_action(action, size: int) -> np.ndarray:
     return array.astype(np.float64)
 
 
+def _length(vector: np.ndarray) -> float:
+    """Euclidean length: np.linalg.norm's own formula, without its checks (a per-step path)."""
+    return math.sqrt(vector.dot(vector))
+
+
 def as_targets(targets, name: str) -> np.ndarray:
     """(n, 2) finite head positions (x, z); one (2,) position is one target. Anything else (a
     (4, 3) or (1, 4) array) is an error, not silently reshaped into other targets."""
@@ -302,8 +307,7 @@ class Reach(base.Task):
         return reading
 
     def position_error(self, physics) -> float:
-        to_target = self.target_position - self.head_xz(physics)
-        return math.sqrt(to_target.dot(to_target))  # np.linalg.norm's own formula, without its checks
+        return _length(self.target_position - self.head_xz(physics))
 
     def attitude_error(self, physics) -> float:
         """Signed head attitude error in degrees (positive = head pitched down), in [-180, 180)."""
@@ -366,8 +370,7 @@ class Reach(base.Task):
         if physics.divergence is not None:
             return -2.0 if self.reward_name == "lesson1" else -2.0 * self.weights.largest_penalty
         head, attitude = self._head_reading = self.head_xz(physics), physics.head_attitude()
-        to_target = self.target_position - head
-        error = math.sqrt(to_target.dot(to_target))  # position_error's formula
+        error = _length(self.target_position - head)  # position_error, on this reading
         if self.reward_name == "lesson1":
             return rewards.lesson1_reward(error, self.position_tolerance)
         return rewards.lesson2_reward(error, physics_lib.attitude_error_deg(attitude, self.desired_attitude),
@@ -421,8 +424,7 @@ class Track(Reach):
 
     def get_observation(self, physics):
         obs = super().get_observation(physics)
-        to_target = obs["to_target"]  # position_error's formula on the same reading
-        obs["position_error"] = np.array([math.sqrt(to_target.dot(to_target))])
+        obs["position_error"] = np.array([_length(obs["to_target"])])  # position_error, same reading
         obs["target_index"] = np.array([float(self.target_index)])
         return obs
 
