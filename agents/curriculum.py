@@ -98,7 +98,8 @@ def check_lesson_names(plan, config: SACConfig, layout: Optional[str] = None) ->
     or one on a dm_control plan, fails here too."""
     arm_domains = {d for d in (as_domain(lesson.domain, layout) for lesson in plan) if d.is_arm}
     named = {"her_lessons": config.her_lessons if config.her_ratio > 0 and arm_domains else (),
-             "long_horizon_lessons": config.long_horizon_lessons}
+             "long_horizon_lessons": config.long_horizon_lessons,
+             "exploration_lessons": config.exploration_lessons}
     known = {lesson.task for lesson in plan} | {task for domain in arm_domains for task in domain.tasks()}
     for field, lessons in named.items():
         unknown = sorted(set(lessons) - known)
@@ -153,10 +154,13 @@ class CurriculumRun:
                                 **self.task_kwargs)
 
     def _enter_lesson(self):
-        """What the loop changes with the lesson besides the environment: the hindsight share and
-        the discount."""
+        """What the loop changes with the lesson besides the environment: the hindsight share,
+        the discount and the target entropy."""
         self.loop.her_ratio = self.config.her_ratio_in_lesson(self.lesson.task)
         self.loop.learner.set_discount(self.config.discount_in_lesson(self.lesson.task))
+        learner = self.loop.learner
+        learner.set_target_entropy(self.config.target_entropy_in_lesson(self.lesson.task,
+                                                                         learner.networks.action_size))
 
     def lesson_checkpoint_path(self, lessons_done: int) -> str:
         """Where ``keep_lesson_checkpoints`` writes the checkpoint after ``lessons_done`` lessons."""

@@ -265,3 +265,41 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
                       run_dir=str(tmp_path / "bad"))
     with pytest.raises(ValueError, match="long_horizon_discount must be in"):
         dataclasses.replace(TINY, long_horizon_discount=1.5)
+
+
+def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_resume(tmp_path):
+    """exploration_lessons: the named lesson's temperature steers to
+    exploration_target_entropy_per_action x |A| (a higher entropy: the temperature rises above
+    the plain run's), the run is the plain one bit for bit until that lesson, a resumed run keeps
+    the lesson's target, and a misspelt lesson or a NaN target is an error."""
+    import dataclasses
+    plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
+    explore = dataclasses.replace(TINY, exploration_lessons=("hard",), exploration_target_entropy_per_action=1.0)
+    plain = CurriculumRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
+    other = CurriculumRun(plan, explore, seed=0, run_dir=str(tmp_path / "explore"), checkpoint_every=600)
+    actions = other.loop.learner.networks.action_size
+    assert other.loop.learner.config.resolved_target_entropy(actions) == -2.0 * actions
+    for run in (plain, other):
+        with pytest.raises(TrainingInterrupted):
+            run.run(stop_at_step=400)
+    assert_same_run(plain, other)
+    at_switch = float(np.exp(other.loop.learner.state.log_alpha))
+    assert other.loop.learner.config.resolved_target_entropy(actions) == 1.0 * actions
+    plain.run()
+    with pytest.raises(TrainingInterrupted):
+        other.run(stop_at_step=600)
+    resumed = CurriculumRun(plan, explore, seed=0, run_dir=str(tmp_path / "explore"))
+    resumed.restore()
+    assert resumed.loop.learner.config.resolved_target_entropy(actions) == 1.0 * actions
+    other.run()
+    resumed.run()
+    assert_same_run(resumed, other)
+    temperature = {name: float(np.exp(run.loop.learner.state.log_alpha)) for name, run in
+                   (("plain", plain), ("explore", other))}
+    # Over the second lesson the plain run's temperature keeps falling, the explorer's turns up.
+    assert temperature["explore"] > at_switch > temperature["plain"], (at_switch, temperature)
+    with pytest.raises(ValueError, match=r"exploration_lessons names \['lesson3'\]"):
+        CurriculumRun(plan, dataclasses.replace(TINY, exploration_lessons=("lesson3",)), seed=0,
+                      run_dir=str(tmp_path / "bad"))
+    with pytest.raises(ValueError, match="exploration_target_entropy_per_action must be finite"):
+        dataclasses.replace(TINY, exploration_target_entropy_per_action=float("nan"))

@@ -62,6 +62,11 @@ class SACConfig:
     # arm longer than settling from the fixed start; 0.99 at 125 Hz looks 0.8 s ahead, 0.995 1.6 s.
     long_horizon_lessons: Tuple[str, ...] = ()
     long_horizon_discount: float = 0.995
+    # Lessons that train toward `exploration_target_entropy_per_action` x |A| instead of the
+    # target entropy above (empty: none). Lesson 3's moves between targets can need a manoeuvre
+    # (uncurling the neck through a whole turn) that the policy's narrow noise never tries.
+    exploration_lessons: Tuple[str, ...] = ()
+    exploration_target_entropy_per_action: float = -1.0
     # Recompute every sampled transition's reward with the current lesson's reward function
     # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
     # replay then carry lesson-2 rewards instead of the ones they were collected with.
@@ -102,7 +107,7 @@ class SACConfig:
                                      "her_level_goals": False, "policy_average": 0.0,
                                      "policy_average_fraction": 0.0, "pre_tanh_penalty": 0.0}
     # Fields that name lesson tasks (tuples here, lists in a fingerprint).
-    LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons")
+    LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons", "exploration_lessons")
 
     def __post_init__(self):
         if min(self.batch_size, self.updates_per_call, self.env_steps_per_call, self.action_repeat) <= 0:
@@ -125,8 +130,9 @@ class SACConfig:
             raise ValueError("residual_scale and her_ratio do not mix: a relabelled goal changes the lookup's "
                              "base action, so the stored residual would no longer mean what it did "
                              "(pass her_ratio=0, --her-ratio 0)")
-        if not np.isfinite(self.target_entropy_per_action):
-            raise ValueError(f"target_entropy_per_action must be finite, got {self.target_entropy_per_action}")
+        for name in ("target_entropy_per_action", "exploration_target_entropy_per_action"):
+            if not np.isfinite(getattr(self, name)):
+                raise ValueError(f"{name} must be finite, got {getattr(self, name)}")
         if not 0.0 <= self.policy_average < 1.0:
             raise ValueError(f"policy_average must be a rate in [0, 1) (0 = off), got {self.policy_average}")
         if not 0.0 <= self.policy_average_fraction <= 1.0:
@@ -151,6 +157,12 @@ class SACConfig:
     def discount_in_lesson(self, task: str) -> float:
         """The discount while training on ``task``: ``long_horizon_discount`` in the named lessons."""
         return self.long_horizon_discount if task in self.long_horizon_lessons else self.discount
+
+    def target_entropy_in_lesson(self, task: str, action_size: int) -> float:
+        """The entropy the temperature steers to while training on ``task``."""
+        if task in self.exploration_lessons:
+            return self.exploration_target_entropy_per_action * float(action_size)
+        return self.resolved_target_entropy(action_size)
 
     def resolved_target_entropy(self, action_size: int) -> float:
         if self.target_entropy is not None:

@@ -167,6 +167,12 @@ class SACLearner:
             self.config = dataclasses.replace(self.config, discount=float(discount))
             self._update_many = _jitted_update_many(self.networks, self.config)
 
+    def set_target_entropy(self, target_entropy: float) -> None:
+        """Train on toward another target entropy (a curriculum's per-lesson exploration)."""
+        if target_entropy != self.config.resolved_target_entropy(self.networks.action_size):
+            self.config = dataclasses.replace(self.config, target_entropy=float(target_entropy))
+            self._update_many = _jitted_update_many(self.networks, self.config)
+
     @property
     def policy_params(self):
         """What the agent explores with while it trains."""
