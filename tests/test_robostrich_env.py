@@ -417,6 +417,44 @@ def test_stored_starts_begin_lesson3_episodes_where_a_stored_input_holds_the_arm
         robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(stored_starts=0.5, start_inputs=[np.nan] * 9))
 
 
+def test_release_starts_begin_lesson3_episodes_on_the_way_out_of_a_curled_neck():
+    """release_starts=1: every continued lesson-3 episode starts after the tendons were released
+    for up to release_time: from a neck curled back by a turn (antagonist_pairs' stored pose for a
+    low target, attitude -270 deg) the starts spread along its way up (one still below -150 deg,
+    one past -30 deg), with the clock at 0 and the servos at zero contraction; release_starts=0
+    starts exactly where the last episode ended; bad values are errors naming the option."""
+    from robostrich_suite.model import layouts
+    layout = layouts.build("antagonist_pairs")
+    poses = targets.level_head_poses(layouts.target_file("antagonist_pairs"))
+    curled = int(np.argmin(poses["head_attitude"]))
+    assert poses["head_attitude"][curled] < -260
+    hold = poses["control"][curled]
+    starts = {}
+    for share in (0.0, 1.0):
+        env = robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(
+            tendon_layout=layout, target_pool=targets.training_targets(layouts.target_file("antagonist_pairs")),
+            release_starts=share, random=0))
+        timestep, starts[share] = env.reset(), []
+        for _ in range(8):
+            while not timestep.last():
+                timestep = env.step(hold)
+            end = env.physics.data.qpos.copy()
+            assert env.physics.head_attitude() < -260  # curled back when the episode ends
+            timestep = env.reset()
+            assert env.physics.time() == 0.0
+            starts[share].append(env.physics.head_attitude())
+            if share == 0.0:
+                np.testing.assert_array_equal(env.physics.data.qpos, end)
+            else:
+                np.testing.assert_array_equal(env.physics.arm_control(), np.zeros(9))
+    assert max(starts[0.0]) < -260
+    assert min(starts[1.0]) < -150 and max(starts[1.0]) > -30, starts[1.0]
+    with pytest.raises(ValueError, match="release_starts must be a share between 0 and 1, got -0.1"):
+        robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(release_starts=-0.1))
+    with pytest.raises(ValueError, match="release_time must be a positive finite time"):
+        robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(release_starts=0.5, release_time=0))
+
+
 @pytest.mark.parametrize("domain", ["robostrich", "robostrich_a1"])
 def test_the_arm_physics_steps_exactly_as_dm_controls_physics_step(domain):
     """The per-step path calls MuJoCo directly (dm_control's wrapper cost as much as the

@@ -10,7 +10,11 @@ They differ in how an episode starts:
   after a divergence, starts fixed.  With ``stored_starts`` > 0, that share of
   the episodes starts instead where the arm comes to rest holding one of
   ``start_inputs`` (stored level poses), so the agent also learns to leave
-  poses it would never reach by itself.
+  poses it would never reach by itself.  With ``release_starts`` > 0, that share
+  of the episodes starts after the arm, from the last episode's final state, had
+  every tendon released (zero contraction) for a random time up to
+  ``release_time``: the states a neck passes through while it uncurls, which a
+  policy that holds its inputs never visits.
 
 ``Track`` is the evaluation task of Fig. 7: a sequence of targets reached in
 order, one after another, within one episode.
@@ -44,6 +48,7 @@ TARGET_SAMPLINGS = ("uniform", "failures")
 # How long a stored start holds its inputs from the fixed pose before the episode begins: as
 # long as the evaluation's moving starts hold theirs (one 2 s episode), so the arm is at rest.
 STORED_START_SETTLE_TIME = 2.0  # s
+RELEASE_TIME = 1.0  # s: releasing a neck curled back by a turn brings it up to level in 0.8 s
 
 
 def validate_action(action, size: int) -> np.ndarray:
@@ -111,6 +116,8 @@ class Reach(base.Task):
     _last_reached = None
     stored_starts = 0.0
     start_inputs = None
+    release_starts = 0.0
+    release_time = RELEASE_TIME
     _head_reading = None
 
     def __init__(self, reward: str = "lesson2", initial_state: str = "fixed",
@@ -119,7 +126,8 @@ class Reach(base.Task):
                  desired_attitude: float = DESIRED_ATTITUDE,
                  weights: rewards.RewardWeights | dict | None = None,
                  target_axes=(0, 2), randomization=None, target_sampling: str = "uniform",
-                 stored_starts: float = 0.0, start_inputs=None, random=None):
+                 stored_starts: float = 0.0, start_inputs=None, release_starts: float = 0.0,
+                 release_time: float = RELEASE_TIME, random=None):
         """
         Args:
           reward: ``"lesson1"`` (eq. 9) or ``"lesson2"`` (eq. 10).
@@ -140,6 +148,9 @@ class Reach(base.Task):
             Ignored by ``"fixed"`` lessons, so one option can serve a whole curriculum.
           start_inputs: (n, tendons) tendon inputs for ``stored_starts`` (the agent layer
             passes the lookup table's, minus the evaluation's start poses).
+          release_starts: share (0-1) of a ``"continue"`` lesson's episodes (those that
+            continue from the last state) that start after every tendon was released for a
+            uniformly drawn time in [0, ``release_time``] s; 0 (default): the paper's lesson 3.
         """
         if reward not in REWARDS:
             raise ValueError(f"unknown reward {reward!r}; use one of {REWARDS}")
@@ -168,7 +179,13 @@ class Reach(base.Task):
             if start_inputs.ndim != 2 or len(start_inputs) == 0 or not np.all(np.isfinite(start_inputs)):
                 raise ValueError("start_inputs must be a non-empty (n, tendons) array of finite tendon "
                                  f"inputs, got shape {start_inputs.shape}")
+        if not (np.isfinite(release_starts) and 0.0 <= release_starts <= 1.0):
+            raise ValueError(f"release_starts must be a share between 0 and 1, got {release_starts}")
+        if not (np.isfinite(release_time) and release_time > 0):
+            raise ValueError(f"release_time must be a positive finite time in seconds, got {release_time}")
         self.stored_starts = float(stored_starts)
+        self.release_starts = float(release_starts)
+        self.release_time = float(release_time)
         self.start_inputs = start_inputs
         self.reward_name = reward
         self.initial_state = initial_state
@@ -200,6 +217,8 @@ class Reach(base.Task):
                 self._settle_at_stored_input(physics)
             elif self._last_state is not None:
                 self._restore_last_state(physics)
+                if self.release_starts and self.random.rand() < self.release_starts:
+                    self._release(physics, self.random.uniform(0.0, self.release_time))
         self.target_position = self.next_target()
         super().initialize_episode(physics)
 
@@ -219,6 +238,18 @@ class Reach(base.Task):
         inputs = self.start_inputs[self.random.randint(len(self.start_inputs))]
         physics.set_arm_control(check_action(inputs, physics.arm_control_bounds()))
         physics.step(int(round(STORED_START_SETTLE_TIME / physics.timestep())))
+        if physics.divergence is not None:
+            physics.reset()
+        physics.data.time = 0.0
+
+    def _release(self, physics, seconds: float):
+        """Every tendon at zero contraction for ``seconds``; the episode's clock then starts at 0.
+        A divergence while released leaves the fixed pose (and is logged like any other)."""
+        steps = int(round(seconds / physics.timestep()))
+        if steps < 1:
+            return
+        physics.set_arm_control(np.zeros(len(physics.arm_control_bounds()[0])))
+        physics.step(steps)
         if physics.divergence is not None:
             physics.reset()
         physics.data.time = 0.0
