@@ -4,6 +4,7 @@ The policy network works in [-1, 1]^|A|; `ActionAdapter` maps that box onto
 the BoundedArray spec (e.g. tendon contractions in metres) and back.
 """
 import jax
+import jax.numpy as jnp
 import numpy as np
 
 
@@ -76,6 +77,11 @@ class Actor:
         self.params = params
         self.deterministic = deterministic
         self.key = jax.random.PRNGKey(0) if key is None else key
+        # Exploration noise correlated over control steps: the Gaussian's standard normal draw
+        # follows eps' = rho eps + sqrt(1 - rho^2) n (stationary, unit variance) instead of a
+        # fresh n every step (rho = 0: plain SAC). Needs `networks.policy_apply`.
+        self.noise_correlation = 0.0
+        self.noise = None  # eps, (action size,); None until the first correlated step
 
         def stochastic(params, obs, key):
             key, sample_key = jax.random.split(key)
@@ -85,7 +91,15 @@ class Actor:
         def mode(params, obs):
             return networks.mode(params, obs[None])[0]
 
+        def correlated(params, obs, key, noise, rho):
+            key, sample_key = jax.random.split(key)
+            fresh = jax.random.normal(sample_key, noise.shape, noise.dtype)
+            noise = rho * noise + jnp.sqrt(1.0 - rho * rho) * fresh
+            mean, log_std = networks.policy_apply(params, obs[None])
+            return jnp.tanh(mean[0] + jnp.exp(log_std[0]) * noise), key, noise
+
         self._stochastic = jax.jit(stochastic)
+        self._correlated = jax.jit(correlated)
         self._mode = jax.jit(mode)
 
     def update(self, params):
@@ -95,6 +109,12 @@ class Actor:
         """Action in [-1, 1]; raises if the network produced NaN/inf."""
         if self.deterministic:
             action = self._mode(self.params, flat_obs)
+        elif self.noise_correlation > 0.0:
+            if self.noise is None:  # start from the process' stationary distribution
+                self.key, start_key = jax.random.split(self.key)
+                self.noise = jax.random.normal(start_key, (self.adapter.size,), jnp.float32)
+            action, self.key, self.noise = self._correlated(self.params, flat_obs, self.key, self.noise,
+                                                            jnp.float32(self.noise_correlation))
         else:
             action, self.key = self._stochastic(self.params, flat_obs, self.key)
         action = np.asarray(action)

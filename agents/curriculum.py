@@ -155,12 +155,13 @@ class CurriculumRun:
 
     def _enter_lesson(self):
         """What the loop changes with the lesson besides the environment: the hindsight share,
-        the discount and the target entropy."""
+        the discount, the target entropy and the exploration noise's correlation."""
         self.loop.her_ratio = self.config.her_ratio_in_lesson(self.lesson.task)
         self.loop.learner.set_discount(self.config.discount_in_lesson(self.lesson.task))
         learner = self.loop.learner
         learner.set_target_entropy(self.config.target_entropy_in_lesson(self.lesson.task,
                                                                          learner.networks.action_size))
+        self.loop.actor.noise_correlation = self.config.noise_correlation_in_lesson(self.lesson.task)
 
     def lesson_checkpoint_path(self, lessons_done: int) -> str:
         """Where ``keep_lesson_checkpoints`` writes the checkpoint after ``lessons_done`` lessons."""
@@ -202,6 +203,7 @@ class CurriculumRun:
         return {
             "learner": loop.learner.get_state(),
             "actor_key": np.asarray(loop.actor.key),
+            "actor_noise": None if loop.actor.noise is None else np.asarray(loop.actor.noise),
             "replay": loop.replay.state_dict(),
             "loop": loop.state_dict(),
             "lesson_index": self.lesson_index,
@@ -220,6 +222,8 @@ class CurriculumRun:
         loop.learner.set_state(state["learner"])
         loop.actor.update(loop.learner.policy_params)
         loop.actor.key = np.asarray(state["actor_key"])
+        noise = state.get("actor_noise")  # absent in checkpoints written before correlated noise
+        loop.actor.noise = None if noise is None else np.asarray(noise, np.float32)
         loop.replay.load_state_dict(state["replay"])
         self.lesson_index, self.lesson_steps = state["lesson_index"], state["lesson_steps"]
         if state["environment"] is not None:

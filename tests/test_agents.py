@@ -187,6 +187,28 @@ def test_actor_stays_in_bounds_and_rejects_nan():
         actor.select_action(np.full(OBS, np.nan, np.float32))
 
 
+def test_correlated_exploration_noise_follows_an_ar1_process_with_the_policys_spread():
+    """noise_correlation rho: the standardised exploration noise (pre-tanh sample minus mean, over
+    the std) of successive steps correlates at about rho and keeps unit variance; 0 is plain SAC's
+    white noise (lag-1 correlation near 0). The same observation every step, so only noise moves."""
+    learner = make_learner()
+    obs = np.full(OBS, 0.2, np.float32)
+    mean, log_std = (np.asarray(x[0]) for x in learner.networks.policy_apply(learner.policy_params, obs[None]))
+    lag1, spread = {}, {}
+    for rho in (0.0, 0.95):
+        actor = Actor(learner.networks, ActionAdapter(specs.BoundedArray((ACT,), np.float64, -1.0, 1.0)),
+                      learner.policy_params, key=jax.random.PRNGKey(3))
+        actor.noise_correlation = rho
+        u = np.arctanh(np.clip([actor.policy_action(obs) for _ in range(3000)], -0.999999, 0.999999))
+        eps = (u - mean) / np.exp(log_std)
+        lag1[rho] = float(np.mean([np.corrcoef(eps[:-1, i], eps[1:, i])[0, 1] for i in range(ACT)]))
+        spread[rho] = float(eps.std())
+    assert abs(lag1[0.0]) < 0.1 and 0.9 < lag1[0.95] < 0.99, lag1
+    assert 0.8 < spread[0.0] < 1.2 and 0.6 < spread[0.95] < 1.4, spread
+    with pytest.raises(ValueError, match="exploration_noise_correlation must be in"):
+        SACConfig(exploration_noise_correlation=1.0)
+
+
 def test_action_anchor_keeps_the_deterministic_action_near_zero():
     """A residual policy's anchor: on the same batches, a weighted penalty on the squared
     deterministic action keeps it far closer to 0 (the base controller) than plain SAC's actor."""

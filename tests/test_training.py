@@ -270,11 +270,13 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
 def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_resume(tmp_path):
     """exploration_lessons: the named lesson's temperature steers to
     exploration_target_entropy_per_action x |A| (a higher entropy: the temperature rises above
-    the plain run's), the run is the plain one bit for bit until that lesson, a resumed run keeps
-    the lesson's target, and a misspelt lesson or a NaN target is an error."""
+    the plain run's) and explores with correlated noise; the run is the plain one bit for bit
+    until that lesson, a resumed run keeps the lesson's target and its noise state (the same run
+    to the end), and a misspelt lesson or a NaN target is an error."""
     import dataclasses
     plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
-    explore = dataclasses.replace(TINY, exploration_lessons=("hard",), exploration_target_entropy_per_action=1.0)
+    explore = dataclasses.replace(TINY, exploration_lessons=("hard",), exploration_target_entropy_per_action=1.0,
+                                  exploration_noise_correlation=0.9)
     plain = CurriculumRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
     other = CurriculumRun(plan, explore, seed=0, run_dir=str(tmp_path / "explore"), checkpoint_every=600)
     actions = other.loop.learner.networks.action_size
@@ -291,9 +293,12 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     resumed = CurriculumRun(plan, explore, seed=0, run_dir=str(tmp_path / "explore"))
     resumed.restore()
     assert resumed.loop.learner.config.resolved_target_entropy(actions) == 1.0 * actions
+    assert resumed.loop.actor.noise_correlation == 0.9 and plain.loop.actor.noise_correlation == 0.0
+    np.testing.assert_array_equal(resumed.loop.actor.noise, other.loop.actor.noise)  # the AR(1) state
     other.run()
     resumed.run()
     assert_same_run(resumed, other)
+    np.testing.assert_array_equal(np.asarray(resumed.loop.actor.noise), np.asarray(other.loop.actor.noise))
     temperature = {name: float(np.exp(run.loop.learner.state.log_alpha)) for name, run in
                    (("plain", plain), ("explore", other))}
     # Over the second lesson the plain run's temperature keeps falling, the explorer's turns up.

@@ -67,6 +67,10 @@ class SACConfig:
     # (uncurling the neck through a whole turn) that the policy's narrow noise never tries.
     exploration_lessons: Tuple[str, ...] = ()
     exploration_target_entropy_per_action: float = -1.0
+    # ... and explore there with noise correlated over control steps (AR(1) coefficient per step
+    # of the policy Gaussian's standard normal draw; 0 = white noise, as plain SAC): a swing of
+    # 50 control steps is not something independent noise at every step produces.
+    exploration_noise_correlation: float = 0.0
     # Recompute every sampled transition's reward with the current lesson's reward function
     # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
     # replay then carry lesson-2 rewards instead of the ones they were collected with.
@@ -133,6 +137,9 @@ class SACConfig:
         for name in ("target_entropy_per_action", "exploration_target_entropy_per_action"):
             if not np.isfinite(getattr(self, name)):
                 raise ValueError(f"{name} must be finite, got {getattr(self, name)}")
+        if not 0.0 <= self.exploration_noise_correlation < 1.0:
+            raise ValueError("exploration_noise_correlation must be in [0, 1) (0 = white noise), "
+                             f"got {self.exploration_noise_correlation}")
         if not 0.0 <= self.policy_average < 1.0:
             raise ValueError(f"policy_average must be a rate in [0, 1) (0 = off), got {self.policy_average}")
         if not 0.0 <= self.policy_average_fraction <= 1.0:
@@ -163,6 +170,10 @@ class SACConfig:
         if task in self.exploration_lessons:
             return self.exploration_target_entropy_per_action * float(action_size)
         return self.resolved_target_entropy(action_size)
+
+    def noise_correlation_in_lesson(self, task: str) -> float:
+        """The exploration noise's correlation per control step while training on ``task``."""
+        return self.exploration_noise_correlation if task in self.exploration_lessons else 0.0
 
     def resolved_target_entropy(self, action_size: int) -> float:
         if self.target_entropy is not None:
