@@ -64,6 +64,19 @@ def validate_action(action, size: int) -> np.ndarray:
     return array.astype(np.float64)
 
 
+def _hold_before_episode(physics, inputs, seconds: float) -> None:
+    """Hold tendon ``inputs`` for ``seconds`` before an episode (stored and release starts); its
+    clock then starts at 0.  A divergence meanwhile leaves the fixed pose (logged like any other)."""
+    steps = int(round(seconds / physics.timestep()))
+    if steps < 1:
+        return
+    physics.set_arm_control(check_action(inputs, physics.arm_control_bounds()))
+    physics.step(steps)
+    if physics.divergence is not None:
+        physics.reset()
+    physics.data.time = 0.0
+
+
 def _length(vector: np.ndarray) -> float:
     """Euclidean length: np.linalg.norm's own formula, without its checks (a per-step path)."""
     return math.sqrt(vector.dot(vector))
@@ -218,7 +231,8 @@ class Reach(base.Task):
             elif self._last_state is not None:
                 self._restore_last_state(physics)
                 if self.release_starts and self.random.rand() < self.release_starts:
-                    self._release(physics, self.random.uniform(0.0, self.release_time))
+                    released = np.zeros(len(physics.arm_control_bounds()[0]))  # every tendon at rest length
+                    _hold_before_episode(physics, released, self.random.uniform(0.0, self.release_time))
         self.target_position = self.next_target()
         super().initialize_episode(physics)
 
@@ -236,23 +250,7 @@ class Reach(base.Task):
         evaluation's moving starts do; the episode's clock then starts at 0.  A divergence
         while settling leaves the fixed pose (and is logged like any other)."""
         inputs = self.start_inputs[self.random.randint(len(self.start_inputs))]
-        physics.set_arm_control(check_action(inputs, physics.arm_control_bounds()))
-        physics.step(int(round(STORED_START_SETTLE_TIME / physics.timestep())))
-        if physics.divergence is not None:
-            physics.reset()
-        physics.data.time = 0.0
-
-    def _release(self, physics, seconds: float):
-        """Every tendon at zero contraction for ``seconds``; the episode's clock then starts at 0.
-        A divergence while released leaves the fixed pose (and is logged like any other)."""
-        steps = int(round(seconds / physics.timestep()))
-        if steps < 1:
-            return
-        physics.set_arm_control(np.zeros(len(physics.arm_control_bounds()[0])))
-        physics.step(steps)
-        if physics.divergence is not None:
-            physics.reset()
-        physics.data.time = 0.0
+        _hold_before_episode(physics, inputs, STORED_START_SETTLE_TIME)
 
     def _count_previous_episode(self):
         """Score the episode that just ended for ``target_sampling="failures"``: whether its
