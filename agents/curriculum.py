@@ -156,12 +156,11 @@ class CurriculumRun:
     def _enter_lesson(self):
         """What the loop changes with the lesson besides the environment: the hindsight share,
         the discount, the target entropy and the exploration noise's correlation."""
-        self.loop.her_ratio = self.config.her_ratio_in_lesson(self.lesson.task)
-        self.loop.learner.set_discount(self.config.discount_in_lesson(self.lesson.task))
-        learner = self.loop.learner
-        learner.set_target_entropy(self.config.target_entropy_in_lesson(self.lesson.task,
-                                                                         learner.networks.action_size))
-        self.loop.actor.noise_correlation = self.config.noise_correlation_in_lesson(self.lesson.task)
+        loop, task = self.loop, self.lesson.task
+        loop.her_ratio = self.config.her_ratio_in_lesson(task)
+        loop.learner.set_discount(self.config.discount_in_lesson(task))
+        loop.learner.set_target_entropy(self.config.target_entropy_in_lesson(task, loop.learner.networks.action_size))
+        loop.actor.noise_correlation = self.config.noise_correlation_in_lesson(task)
 
     def lesson_checkpoint_path(self, lessons_done: int) -> str:
         """Where ``keep_lesson_checkpoints`` writes the checkpoint after ``lessons_done`` lessons."""

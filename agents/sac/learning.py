@@ -164,14 +164,17 @@ class SACLearner:
     def set_discount(self, discount: float) -> None:
         """Train on with another discount (a curriculum's per-lesson discount); the state carries over."""
         if discount != self.config.discount:
-            self.config = dataclasses.replace(self.config, discount=float(discount))
-            self._update_many = _jitted_update_many(self.networks, self.config)
+            self._retune(discount=float(discount))
 
     def set_target_entropy(self, target_entropy: float) -> None:
         """Train on toward another target entropy (a curriculum's per-lesson exploration)."""
         if target_entropy != self.config.resolved_target_entropy(self.networks.action_size):
-            self.config = dataclasses.replace(self.config, target_entropy=float(target_entropy))
-            self._update_many = _jitted_update_many(self.networks, self.config)
+            self._retune(target_entropy=float(target_entropy))
+
+    def _retune(self, **fields) -> None:
+        """Replace config fields the update is compiled with; the training state carries over."""
+        self.config = dataclasses.replace(self.config, **fields)
+        self._update_many = _jitted_update_many(self.networks, self.config)
 
     @property
     def policy_params(self):
