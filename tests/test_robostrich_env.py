@@ -360,7 +360,7 @@ def test_failure_sampling_draws_the_targets_the_agent_misses_more_often():
     far = start + np.array([0.3, -0.5])
     pool = np.stack([start, far])
     draws = {}
-    for sampling in ("uniform", "failures"):
+    for sampling in ("uniform", "failures", "continue_failures"):
         env = robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(
             target_sampling=sampling, target_pool=pool, time_limit=0.1, random=3,
             attitude_tolerance=180.0))
@@ -375,14 +375,37 @@ def test_failure_sampling_draws_the_targets_the_agent_misses_more_often():
                 ts = env.step(np.zeros(9))
             final = ts.observation["joint_angles"]
         draws[sampling] = far_draws
-        if sampling == "failures":
+        if sampling != "uniform":
             tries, failures = env.task.target_tries, env.task.target_failures
             assert tries.sum() == 39  # every episode but the one still running
             assert failures[0] == 0 and failures[1] == tries[1]
     assert 12 <= draws["uniform"] <= 28
     assert draws["failures"] >= 32
+    assert draws["continue_failures"] == draws["failures"]  # lesson 3 continues: the same draws
     with pytest.raises(ValueError, match="unknown target_sampling 'worst'"):
         robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(target_sampling="worst"))
+
+
+def test_continue_failures_leaves_fixed_start_lessons_uniform():
+    """target_sampling="continue_failures" in a fixed-start lesson draws exactly the targets of
+    uniform sampling (so lessons 1-2 of a run stay the paper's, episode for episode), where
+    "failures" draws the missed far target more often."""
+    start = robostrich_suite.load("robostrich", "lesson1").reset().observation["head_position"]
+    far = start + np.array([0.3, -0.5])
+    pool = np.stack([start, far])
+    targets = {}
+    for sampling in ("uniform", "failures", "continue_failures"):
+        env = robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(
+            target_sampling=sampling, target_pool=pool, time_limit=0.1, random=3))
+        targets[sampling] = []
+        for _ in range(30):
+            ts = env.reset()
+            targets[sampling].append(tuple(ts.observation["target_position"]))
+            while not ts.last():
+                ts = env.step(np.zeros(9))
+        assert env.task.target_tries.sum() == (29 if sampling == "failures" else 0)
+    assert targets["continue_failures"] == targets["uniform"]
+    assert targets["failures"] != targets["uniform"]
 
 
 def test_stored_starts_begin_lesson3_episodes_where_a_stored_input_holds_the_arm():

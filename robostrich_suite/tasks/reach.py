@@ -43,8 +43,10 @@ INITIAL_STATES = ("fixed", "continue")
 REWARDS = ("lesson1", "lesson2")
 # How the next target is drawn from the pool: "uniform" (the paper), or "failures": each
 # target in proportion to its estimated failure rate, (failures + 1) / (tries + 2), judged
-# on the previous episode's final pose against what the lesson's reward asks for.
-TARGET_SAMPLINGS = ("uniform", "failures")
+# on the previous episode's final pose against what the lesson's reward asks for;
+# "continue_failures": "failures" in lessons whose episodes continue from the last pose (lesson 3),
+# "uniform" in fixed-start ones, so one option leaves lessons 1-2 the paper's.
+TARGET_SAMPLINGS = ("uniform", "failures", "continue_failures")
 # How long a stored start holds its inputs from the fixed pose before the episode begins: as
 # long as the evaluation's moving starts hold theirs (one 2 s episode), so the arm is at rest.
 STORED_START_SETTLE_TIME = 2.0  # s
@@ -153,8 +155,9 @@ class Reach(base.Task):
           target_axes: world axes of the head position the targets are given in.
           randomization: a ``DomainRandomization`` (or a dict of its fields) to draw
             new arm parameters every episode and add joint-angle noise; None = off.
-          target_sampling: ``"uniform"`` or ``"failures"`` (targets the agent misses are
-            drawn more often; see ``TARGET_SAMPLINGS``).
+          target_sampling: ``"uniform"``, ``"failures"`` (targets the agent misses are
+            drawn more often) or ``"continue_failures"`` (that, in ``"continue"`` lessons
+            only); see ``TARGET_SAMPLINGS``.
           stored_starts: share (0-1) of a ``"continue"`` lesson's episodes that start where
             the arm comes to rest holding one of ``start_inputs`` (drawn uniformly) from the
             fixed pose for ``STORED_START_SETTLE_TIME``; 0 (default): the paper's lesson 3.
@@ -221,7 +224,7 @@ class Reach(base.Task):
     # --- episode structure -------------------------------------------------
     def initialize_episode(self, physics):
         self._head_reading = None
-        if self.target_sampling == "failures":  # before anything moves the physics
+        if self._samples_failures():  # before anything moves the physics
             self._count_previous_episode()
         if self.randomizer is not None:
             self.randomizer.apply(physics, self.random)
@@ -260,6 +263,11 @@ class Reach(base.Task):
             self.target_failures[self._target_index] += not self._last_reached
         self._last_reached = None
 
+    def _samples_failures(self) -> bool:
+        """Whether the next target is drawn by failure rate (and episodes are scored for it)."""
+        return self.target_sampling == "failures" or (
+            self.target_sampling == "continue_failures" and self.initial_state == "continue")
+
     def _lesson_reached(self, physics) -> bool:
         if self.reward_name == "lesson1":  # eq. 9 asks for the position alone
             return self.position_error(physics) <= self.position_tolerance
@@ -285,7 +293,7 @@ class Reach(base.Task):
         self._last_state = None
 
     def next_target(self) -> np.ndarray:
-        if self.target_sampling == "failures":
+        if self._samples_failures():
             failure_rate = (self.target_failures + 1.0) / (self.target_tries + 2.0)
             self._target_index = int(self.random.choice(len(self.target_pool),
                                                         p=failure_rate / failure_rate.sum()))
@@ -312,7 +320,7 @@ class Reach(base.Task):
                                 physics.data.act.copy(), physics.arm_control())
         else:
             self._last_state = None
-        if self.target_sampling == "failures":  # only then: it costs a head measurement per step
+        if self._samples_failures():  # only then: it costs a head measurement per step
             self._last_reached = None if physics.divergence is not None else self._lesson_reached(physics)
 
     def get_termination(self, physics):
