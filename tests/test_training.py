@@ -223,11 +223,13 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     assert training.resolve_layout(None, arm) == "antagonist_pairs"
     assert training.resolve_layout("paper", arm) is None  # the tasks' own layout, as older checkpoints name it
     assert training.resolve_layout("ventral_slips", arm) == "ventral_slips" and training.resolve_layout(None, dmc) is None
-    assert training.resolve_task_kwargs({}, arm) == {"weights": {"position_precision": 1.0}}
+    assert training.resolve_task_kwargs({}, arm) == {"weights": {"position_precision": 1.0},
+                                                     "target_sampling": "failures"}
     assert training.resolve_task_kwargs({"weights": {"position_error": 10}, "position_tolerance": 0.02}, arm) == {
-        "weights": {"position_precision": 1.0, "position_error": 10}, "position_tolerance": 0.02}
-    assert training.resolve_task_kwargs({"weights": {"position_precision": 0}}, arm) == {
-        "weights": {"position_precision": 0}}
+        "weights": {"position_precision": 1.0, "position_error": 10}, "position_tolerance": 0.02,
+        "target_sampling": "failures"}
+    assert training.resolve_task_kwargs({"weights": {"position_precision": 0}, "target_sampling": "uniform"},
+                                        arm) == {"weights": {"position_precision": 0}, "target_sampling": "uniform"}
     assert training.resolve_task_kwargs({}, dmc) == {}
     with pytest.raises(ValueError, match="target_entropy_per_action"):
         SACConfig(target_entropy_per_action=float("nan"))
