@@ -352,13 +352,19 @@ def test_one_target_may_be_given_as_a_pair():
     np.testing.assert_array_equal(env.task.target_position, [0.3, 0.4])
 
 
+def _start_and_far_targets():
+    """A target pool of the head's fixed start position (a hold-still policy reaches it) and one
+    58 cm away (it never does): (the far target, the (2, 2) pool)."""
+    start = robostrich_suite.load("robostrich", "lesson1").reset().observation["head_position"]
+    far = start + np.array([0.3, -0.5])
+    return far, np.stack([start, far])
+
+
 def test_failure_sampling_draws_the_targets_the_agent_misses_more_often():
     """target_sampling="failures": with a hold-still policy, the target at the start pose is
     reached and the one 58 cm away never is; the far one must then be drawn far more often
     than uniform sampling's half, and continued episodes still start where the last one ended."""
-    start = robostrich_suite.load("robostrich", "lesson1").reset().observation["head_position"]
-    far = start + np.array([0.3, -0.5])
-    pool = np.stack([start, far])
+    far, pool = _start_and_far_targets()
     draws = {}
     for sampling in ("uniform", "failures", "continue_failures"):
         env = robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(
@@ -390,9 +396,7 @@ def test_continue_failures_leaves_fixed_start_lessons_uniform():
     """target_sampling="continue_failures" in a fixed-start lesson draws exactly the targets of
     uniform sampling (so lessons 1-2 of a run stay the paper's, episode for episode), where
     "failures" draws the missed far target more often."""
-    start = robostrich_suite.load("robostrich", "lesson1").reset().observation["head_position"]
-    far = start + np.array([0.3, -0.5])
-    pool = np.stack([start, far])
+    far, pool = _start_and_far_targets()
     targets = {}
     for sampling in ("uniform", "failures", "continue_failures"):
         env = robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(
