@@ -39,9 +39,9 @@ DEFAULT_ARM_LAYOUT = "antagonist_pairs"
 # Task arguments of every training lesson on the arm domains, under the ones --task-kwargs gives:
 # a Gaussian position term that keeps paying inside the 5 cm tolerance (rewards.RewardWeights),
 # which brought the median error from 2.5 to under 1 cm, and targets drawn by how often the agent
-# misses them (Reach target_sampling "failures"), with which seven seeds of eight learn to uncurl the
-# neck, five of eight with the uniform draw (docs/learning.md). '{"target_sampling": "uniform"}' gives the paper's draw. Evaluation keeps
-# the task's defaults.
+# misses them (Reach target_sampling "failures"), with which seven seeds of eight learn to uncurl
+# the neck, five of eight with the uniform draw (docs/learning.md); '{"target_sampling":
+# "uniform"}' gives the paper's draw. Evaluation keeps the task's defaults.
 DEFAULT_ARM_TASK_KWARGS = {"weights": {"position_precision": 1.0}, "target_sampling": "failures"}
 
 

@@ -257,7 +257,7 @@ class Reach(base.Task):
 
     def _count_previous_episode(self):
         """Score the episode that just ended for ``target_sampling="failures"``: whether its
-        final pose (recorded by ``after_step``) did what the lesson asks."""
+        final pose (judged by ``get_reward``) did what the lesson asks."""
         if self._target_index is not None and self._last_reached is not None:
             self.target_tries[self._target_index] += 1
             self.target_failures[self._target_index] += not self._last_reached
@@ -267,11 +267,6 @@ class Reach(base.Task):
         """Whether the next target is drawn by failure rate (and episodes are scored for it)."""
         return self.target_sampling == "failures" or (
             self.target_sampling == "continue_failures" and self.initial_state == "continue")
-
-    def _lesson_reached(self, physics) -> bool:
-        if self.reward_name == "lesson1":  # eq. 9 asks for the position alone
-            return self.position_error(physics) <= self.position_tolerance
-        return self.is_success(physics)
 
     def set_target_pool(self, targets) -> None:
         """Draw the next episodes' targets from ``targets`` ((n, 2) or one (2,) position):
@@ -320,8 +315,6 @@ class Reach(base.Task):
                                 physics.data.act.copy(), physics.arm_control())
         else:
             self._last_state = None
-        if self._samples_failures():  # only then: it costs a head measurement per step
-            self._last_reached = None if physics.divergence is not None else self._lesson_reached(physics)
 
     def get_termination(self, physics):
         if physics.divergence is not None:
@@ -404,14 +397,22 @@ class Reach(base.Task):
         return obs
 
     def get_reward(self, physics):
+        """Eq. 9 or 10 on this step's head reading; with failure sampling it also judges, on the
+        same reading, whether the pose does what the lesson asks (the episode's last step's
+        judgement scores its target)."""
         if physics.divergence is not None:
+            self._last_reached = None
             return -2.0 if self.reward_name == "lesson1" else -2.0 * self.weights.largest_penalty
         head, attitude = self._head_reading = self.head_xz(physics), physics.head_attitude()
         error = _length(self.target_position - head)  # position_error, on this reading
         if self.reward_name == "lesson1":
+            if self._samples_failures():
+                self._last_reached = error <= self.position_tolerance  # eq. 9 asks for the position alone
             return rewards.lesson1_reward(error, self.position_tolerance)
-        return rewards.lesson2_reward(error, physics_lib.attitude_error_deg(attitude, self.desired_attitude),
-                                      self.position_tolerance, self.attitude_tolerance,
+        attitude_error = physics_lib.attitude_error_deg(attitude, self.desired_attitude)
+        if self._samples_failures():
+            self._last_reached = error <= self.position_tolerance and abs(attitude_error) <= self.attitude_tolerance
+        return rewards.lesson2_reward(error, attitude_error, self.position_tolerance, self.attitude_tolerance,
                                       self.weights)
 
 
