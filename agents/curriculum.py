@@ -65,7 +65,10 @@ def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, task_kwar
 
 def upgrade_fingerprint(fingerprint: dict) -> dict:
     """A stored fingerprint with the config fields its checkpoint predates filled in as its run had
-    them (`SACConfig.LEGACY_VALUES`), to compare with a fingerprint of today's code."""
+    them (`SACConfig.LEGACY_VALUES`), to compare with a fingerprint of today's code; an arm run's
+    task arguments without ``target_sampling`` (before the main job drew targets by failure) get
+    the task's own default, ``"uniform"``, which that run trained with."""
+    fingerprint = _with_target_sampling(fingerprint)
     if not isinstance(fingerprint.get("config"), dict):
         return fingerprint
     try:
@@ -73,6 +76,17 @@ def upgrade_fingerprint(fingerprint: dict) -> dict:
     except (TypeError, ValueError):
         return fingerprint  # another program's config: the comparison names what differs
     return {**fingerprint, "config": config}
+
+
+def _with_target_sampling(fingerprint: dict) -> dict:
+    task_kwargs = fingerprint.get("task_kwargs")
+    if not isinstance(task_kwargs, dict) or "target_sampling" in task_kwargs:
+        return fingerprint
+    try:
+        arm = all(as_domain(lesson.domain).is_arm for lesson in parse_plan(fingerprint.get("plan", "")))
+    except (TypeError, ValueError):
+        return fingerprint  # not a plan of this program: the comparison names what differs
+    return {**fingerprint, "task_kwargs": {**task_kwargs, "target_sampling": "uniform"}} if arm else fingerprint
 
 
 def make_environment(domain, task: str, seed: int, **task_kwargs):

@@ -121,6 +121,32 @@ def test_checkpoint_from_before_a_config_field_loads_as_its_run_had_it(tmp_path)
         CurriculumRun(plan, today, seed=0, run_dir=str(tmp_path / "b")).restore(path)
 
 
+def test_arm_checkpoint_from_before_failure_sampling_resumes_as_the_uniform_run_it_was(tmp_path):
+    """An arm run's fingerprint without target_sampling (before the main job drew targets by
+    failure) trained with the task's uniform draw: it resumes with '"target_sampling": "uniform"'
+    and is refused under today's failure draw, naming the difference; a dm_control run's task
+    arguments are left as they were."""
+    from agents.curriculum import upgrade_fingerprint
+    plan = parse_plan("robostrich/lesson1:300")
+    uniform = {"weights": {"position_precision": 1.0}, "target_sampling": "uniform"}
+    config = SACConfig(**{**TINY.to_dict(), "hidden_sizes": (32, 32)})
+    run = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300,
+                        task_kwargs=uniform)
+    run.run()
+    old = run.fingerprint()
+    old["task_kwargs"] = {"weights": {"position_precision": 1.0}}
+    path = str(tmp_path / "old.pkl")
+    checkpoint.save(path, checkpoint.load(run.checkpoint_path), old)
+    resumed = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "b"), task_kwargs=uniform)
+    resumed.restore(path)
+    assert_same_run(resumed, run)
+    failures = {**uniform, "target_sampling": "failures"}
+    with pytest.raises(ValueError, match="target_sampling"):
+        CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "c"), task_kwargs=failures).restore(path)
+    dmc = {"plan": "reacher/easy:300", "task_kwargs": {"time_limit": 5}}
+    assert upgrade_fingerprint(dmc) == dmc
+
+
 def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
     plan = parse_plan("point_mass/easy:500,point_mass/hard:500")
     run = CurriculumRun(plan, TINY, seed=2, run_dir=str(tmp_path), checkpoint_every=10_000)
