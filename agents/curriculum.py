@@ -79,6 +79,8 @@ def upgrade_fingerprint(fingerprint: dict) -> dict:
 
 
 def _with_target_sampling(fingerprint: dict) -> dict:
+    """``upgrade_fingerprint``'s part for the task arguments: only an arm run's, whose tasks all
+    take ``target_sampling`` (a dm_control task has no such argument)."""
     task_kwargs = fingerprint.get("task_kwargs")
     if not isinstance(task_kwargs, dict) or "target_sampling" in task_kwargs:
         return fingerprint

@@ -344,8 +344,13 @@ class Reach(base.Task):
         return float(physics_lib.attitude_error_deg(physics.head_attitude(), self.desired_attitude))
 
     def is_success(self, physics) -> bool:
-        return (self.position_error(physics) <= self.position_tolerance
-                and abs(self.attitude_error(physics)) <= self.attitude_tolerance)
+        return self._within_tolerances(self.position_error(physics), self.attitude_error(physics))
+
+    def _within_tolerances(self, position_error: float, attitude_error_deg: float | None = None) -> bool:
+        """Within the position tolerance and, where an attitude error is given, the attitude one:
+        the one success rule of ``is_success`` and of failure sampling's judgement."""
+        return position_error <= self.position_tolerance and (
+            attitude_error_deg is None or abs(attitude_error_deg) <= self.attitude_tolerance)
 
     # --- hindsight goals ------------------------------------------------------
     # The observation keys an agent needs to put another goal into an observation
@@ -407,11 +412,11 @@ class Reach(base.Task):
         error = _length(self.target_position - head)  # position_error, on this reading
         if self.reward_name == "lesson1":
             if self._samples_failures():
-                self._last_reached = error <= self.position_tolerance  # eq. 9 asks for the position alone
+                self._last_reached = self._within_tolerances(error)  # eq. 9 asks for the position alone
             return rewards.lesson1_reward(error, self.position_tolerance)
         attitude_error = physics_lib.attitude_error_deg(attitude, self.desired_attitude)
         if self._samples_failures():
-            self._last_reached = error <= self.position_tolerance and abs(attitude_error) <= self.attitude_tolerance
+            self._last_reached = self._within_tolerances(error, attitude_error)
         return rewards.lesson2_reward(error, attitude_error, self.position_tolerance, self.attitude_tolerance,
                                       self.weights)
 
