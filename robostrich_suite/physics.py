@@ -211,7 +211,14 @@ class ArmPhysicsMixin:
     def _reload_from_data(self, data):
         super()._reload_from_data(data)
         self.__dict__["_raw_model"], self.__dict__["_raw_data"] = data.model.ptr, data.ptr
-        self.__dict__["_indices"] = arm_indices(self.model)
+        indices = self.__dict__["_indices"] = arm_indices(self.model)
+        select = indices.actuator_select
+        # Views into the model's actuator ranges for the per-step readers (an edit of the model's
+        # ranges shows through a view); a copy would go stale, so only where ``select`` is a slice.
+        model = data.model.ptr
+        self.__dict__["_range_views"] = (
+            (model.actuator_ctrlrange[select, 0], model.actuator_ctrlrange[select, 1],
+             model.actuator_forcerange[select, 0]) if isinstance(select, slice) else None)
 
     @property
     def arm_indices(self) -> ArmIndices:
@@ -269,8 +276,9 @@ class ArmPhysicsMixin:
 
     def tendon_tensions(self) -> np.ndarray:
         """Pull in each tendon as a fraction of its actuator's largest pull (0-1)."""
-        select = self._indices.actuator_select
-        return self._raw_data.actuator_force[select] / self._raw_model.actuator_forcerange[select, 0]
+        select, views = self._indices.actuator_select, self._range_views
+        largest_pull = self._raw_model.actuator_forcerange[select, 0] if views is None else views[2]
+        return self._raw_data.actuator_force[select] / largest_pull
 
     def arm_control(self) -> np.ndarray:
         return np.array(self._raw_data.ctrl[self._indices.actuator_select])
@@ -283,6 +291,9 @@ class ArmPhysicsMixin:
         """(low, high) tendon contractions (m) for reading only: where the actuators are
         consecutive these are views into the model, which the per-step action check reads
         instead of copying the (9, 2) range."""
+        views = self._range_views
+        if views is not None:
+            return views[0], views[1]
         ctrlrange = self._raw_model.actuator_ctrlrange[self._indices.actuator_select]
         return ctrlrange[:, 0], ctrlrange[:, 1]
 
@@ -359,7 +370,16 @@ class ArmPhysicsMixin:
         # environment (a resumed training run) then continues bit-exactly.
         mujoco_lib.mj_step1(self.model.ptr, self.data.ptr)
 
+    # The arm's state when the last reset began, (qpos, qvel, act, tendon command), or None if
+    # the episode it ended diverged: a "continue" episode starts from it (``Reach``). Kept here,
+    # once per reset, so that no task has to copy the state after every step in case it is the
+    # episode's last (an unpickled physics starts without one: its state is the live one).
+    state_before_reset: tuple | None = None
+
     def reset(self, keyframe_id=None):
+        data = self.__dict__.get("_raw_data")
+        self.state_before_reset = None if data is None or self.divergence is not None else (
+            data.qpos.copy(), data.qvel.copy(), data.act.copy(), self.arm_control())
         self.divergence = None
         self.episodes_started += 1
         return super().reset(keyframe_id)

@@ -1,5 +1,6 @@
 """The robostrich domain: dm_env conformance, rewards, determinism, bad input."""
 import logging
+import pickle
 
 import numpy as np
 import pytest
@@ -193,6 +194,15 @@ def test_nan_action_raises_and_out_of_range_is_clipped():
     np.testing.assert_array_equal(env.physics.data.ctrl, spec.maximum)
     env.step(np.full(9, -10.0))
     np.testing.assert_array_equal(env.physics.data.ctrl, spec.minimum)
+    # The per-step readers follow an edit of the model's ranges, each physics its own model's.
+    copy = env.physics.copy()
+    env.physics.model.actuator_ctrlrange[:, 1] = 0.5 * spec.maximum
+    env.physics.model.actuator_forcerange[:, 0] *= 2.0
+    env.step(np.full(9, 10.0))
+    np.testing.assert_array_equal(env.physics.data.ctrl, 0.5 * spec.maximum)
+    np.testing.assert_allclose(env.physics.tendon_tensions(), env.physics.tendon_forces()
+                               / -env.physics.model.actuator_forcerange[:, 0])
+    np.testing.assert_array_equal(copy.arm_control_bounds()[1], spec.maximum)  # its model is unchanged
 
 
 def test_divergence_ends_the_episode_with_a_logged_reason(caplog):
@@ -252,6 +262,35 @@ def test_lesson2_starts_fixed_and_lesson3_continues():
             np.testing.assert_array_equal(ts.observation["joint_angles"], final)
         else:
             np.testing.assert_array_equal(ts.observation["joint_angles"], np.zeros(18))
+
+
+def test_lesson3_continues_from_wherever_the_arm_was_reset():
+    """A reset in mid-episode, and one after pickling (a checkpoint), continue from the live pose;
+    after forget_last_state, and for a task pickled with the older _last_state, as stated."""
+    env = robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(random=0))
+    env.reset()
+    for _ in range(30):
+        ts = env.step(np.full(9, 0.01))
+    moved = ts.observation["joint_angles"].copy()
+    assert np.abs(moved).max() > 0.02
+    ts = env.reset()  # mid-episode
+    np.testing.assert_array_equal(ts.observation["joint_angles"], moved)
+    for _ in range(5):
+        env.step(np.zeros(9))
+    unpickled = pickle.loads(pickle.dumps(env))
+    np.testing.assert_array_equal(unpickled.reset().observation["joint_angles"], env.reset().observation["joint_angles"])
+    env.task.forget_last_state()
+    np.testing.assert_array_equal(env.reset().observation["joint_angles"], np.zeros(18))
+    # An environment pickled by the code before the physics kept the pre-reset state: the task
+    # held the last pose as _last_state (None after a divergence or forget_last_state).
+    for last_state, continues in ((("qpos", "qvel", "act", "ctrl"), True), (None, False)):
+        state = dict(env.task.__dict__)
+        del state["_continues_from_physics"]
+        state["_last_state"] = last_state
+        task = object.__new__(type(env.task))
+        task.__setstate__(state)
+        assert task._continues_from_physics is continues
+        assert "_last_state" not in task.__dict__
 
 
 def test_track_visits_targets_in_order():

@@ -162,7 +162,7 @@ class _QuadrupedTaskMixin:
         if callable(schedule) and not isinstance(schedule, gait_lib.TrunkHeightSchedule):
             schedule = schedule(self.random)
         self.height_schedule = schedule or gait_lib.TrunkHeightSchedule()
-        continuing = self.initial_state == "continue" and self._last_state is not None
+        continuing = self.initial_state == "continue" and self._continuing_state(physics) is not None
         if not continuing:
             physics.place_standing(trunk_height=float(self.height_schedule(0.0)))
             physics.forward()

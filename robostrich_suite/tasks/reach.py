@@ -134,6 +134,7 @@ class Reach(base.Task):
     release_starts = 0.0
     release_time = RELEASE_TIME
     _head_reading = None
+    _continues_from_physics = False  # see _continuing_state
 
     def __init__(self, reward: str = "lesson2", initial_state: str = "fixed",
                  target_pool=None, position_tolerance: float = POSITION_TOLERANCE,
@@ -218,7 +219,6 @@ class Reach(base.Task):
         self.randomizer = (randomization_lib.Randomizer(randomization)
                            if randomization is not None else None)
         self.target_position = self.target_pool[0].copy()
-        self._last_state = None
         super().__init__(random=random)
 
     # --- episode structure -------------------------------------------------
@@ -229,18 +229,34 @@ class Reach(base.Task):
         if self.randomizer is not None:
             self.randomizer.apply(physics, self.random)
         if self.initial_state == "continue":
+            last_state = self._continuing_state(physics)
             if self.stored_starts and self.random.rand() < self.stored_starts:
                 self._settle_at_stored_input(physics)
-            elif self._last_state is not None:
-                self._restore_last_state(physics)
+            elif last_state is not None:
+                self._restore_state(physics, last_state)
                 if self.release_starts and self.random.rand() < self.release_starts:
                     released = np.zeros(len(physics.arm_control_bounds()[0]))  # every tendon at rest length
                     _hold_before_episode(physics, released, self.random.uniform(0.0, self.release_time))
         self.target_position = self.next_target()
         super().initialize_episode(physics)
+        self._continues_from_physics = True
 
-    def _restore_last_state(self, physics):
-        qpos, qvel, act, command = self._last_state
+    def _continuing_state(self, physics):
+        """The state a "continue" episode starts from while ``initialize_episode`` runs: where the
+        last episode of this task ended (the physics keeps it at each reset), None before this
+        task's first episode, after a divergence or after :meth:`forget_last_state`."""
+        return physics.state_before_reset if self._continues_from_physics else None
+
+    def __setstate__(self, state):
+        # A task pickled before the physics kept the pre-reset state (an older checkpoint's)
+        # held it as _last_state; its physics unpickles in that state, so continue from it.
+        if "_last_state" in state:
+            state["_continues_from_physics"] = state.pop("_last_state") is not None
+        self.__dict__.update(state)
+
+    @staticmethod
+    def _restore_state(physics, last_state):
+        qpos, qvel, act, command = last_state
         with physics.reset_context():
             physics.data.qpos[:] = qpos
             physics.data.qvel[:] = qvel
@@ -285,7 +301,7 @@ class Reach(base.Task):
 
     def forget_last_state(self) -> None:
         """The next "continue" episode starts from the fixed pose (as after a divergence)."""
-        self._last_state = None
+        self._continues_from_physics = False
 
     def next_target(self) -> np.ndarray:
         if self._samples_failures():
@@ -308,13 +324,6 @@ class Reach(base.Task):
 
     def after_step(self, physics):
         self._head_reading = None
-        # Remember where the arm is for the next episode of a "continue" lesson (always: a
-        # task may be switched to "continue" between episodes, as heldout_moving does).
-        if physics.divergence is None:
-            self._last_state = (physics.data.qpos.copy(), physics.data.qvel.copy(),
-                                physics.data.act.copy(), physics.arm_control())
-        else:
-            self._last_state = None
 
     def get_termination(self, physics):
         if physics.divergence is not None:
