@@ -109,7 +109,8 @@ class Domain:
     def make_environment(self, task: str, seed: int, **task_kwargs):
         """robostrich_suite.load for the arm (with the layout's kwargs), dm_control.suite.load otherwise."""
         task_kwargs = {"random": seed, **self.layout_kwargs(task), **task_kwargs}
-        if self.is_arm and task_kwargs.get("stored_starts") and task_kwargs.get("start_inputs") is None:
+        if (self.is_arm and (task_kwargs.get("stored_starts") or task_kwargs.get("fixed_stored_starts"))
+                and task_kwargs.get("start_inputs") is None):
             task_kwargs["start_inputs"] = self.stored_start_inputs()
         if self.is_arm:
             import robostrich_suite

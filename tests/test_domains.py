@@ -157,7 +157,8 @@ def test_stored_starts_come_from_the_lookup_table_without_the_evaluations_moving
     assert 0 < len(inputs) < len(table["control"])
     for control in start_controls:
         assert not np.any(np.all(inputs == control, axis=1))
-    env = domain.make_environment("lesson3", 0, stored_starts=0.5)
-    np.testing.assert_array_equal(env.task.start_inputs, inputs)
+    for task, option in (("lesson3", "stored_starts"), ("lesson1", "fixed_stored_starts")):
+        env = domain.make_environment(task, 0, **{option: 0.5})
+        np.testing.assert_array_equal(env.task.start_inputs, inputs)
     with pytest.raises(ValueError, match="quadruped"):
         Domain("robostrich_a1").make_environment("lesson3", 0, stored_starts=0.5)

@@ -483,6 +483,36 @@ def test_stored_starts_begin_lesson3_episodes_where_a_stored_input_holds_the_arm
         robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(stored_starts=0.5, start_inputs=[np.nan] * 9))
 
 
+def test_fixed_stored_starts_begin_lesson1_and_2_episodes_at_stored_poses():
+    """fixed_stored_starts: that share of a fixed-start lesson's episodes starts at rest at a stored
+    pose (about half of 16 with 0.5, the others fixed); lesson 3 continues as before."""
+    poses = targets.level_head_poses()
+    inputs, positions = poses["control"][:2], poses["head_position"][:2]
+    for lesson in ("lesson1", "lesson2"):
+        env = robostrich_suite.load("robostrich", lesson, task_kwargs=dict(
+            fixed_stored_starts=0.5, start_inputs=inputs, random=1, time_limit=0.04))
+        stored = 0
+        for _ in range(16):
+            ts = env.reset()
+            head = ts.observation["head_position"]
+            if np.abs(ts.observation["joint_angles"]).max() == 0.0:
+                continue  # the fixed pose
+            assert np.min(np.linalg.norm(positions - head, axis=1)) < 0.01
+            assert np.abs(env.physics.data.qvel).max() < 0.05
+            stored += 1
+        assert 4 <= stored <= 12, stored
+    continued = robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(
+        fixed_stored_starts=1.0, start_inputs=inputs, random=0, time_limit=0.1))
+    continued.reset()
+    for _ in range(5):
+        ts = continued.step(np.full(9, 0.01))
+    np.testing.assert_array_equal(continued.reset().observation["joint_angles"], ts.observation["joint_angles"])
+    with pytest.raises(ValueError, match="fixed_stored_starts must be a share between 0 and 1, got -0.1"):
+        robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(fixed_stored_starts=-0.1, start_inputs=inputs))
+    with pytest.raises(ValueError, match="fixed_stored_starts > 0 needs start_inputs"):
+        robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(fixed_stored_starts=0.5))
+
+
 def test_release_starts_begin_lesson3_episodes_on_the_way_out_of_a_curled_neck():
     """release_starts=1: every continued lesson-3 episode starts after the tendons were released
     for up to release_time: from a neck curled back by a turn (antagonist_pairs' stored pose for a
