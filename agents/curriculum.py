@@ -66,9 +66,9 @@ def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, task_kwar
 def upgrade_fingerprint(fingerprint: dict) -> dict:
     """A stored fingerprint with the config fields its checkpoint predates filled in as its run had
     them (`SACConfig.LEGACY_VALUES`), to compare with a fingerprint of today's code; an arm run's
-    task arguments without ``target_sampling`` (before the main job drew targets by failure) get
-    the task's own default, ``"uniform"``, which that run trained with."""
-    fingerprint = _with_target_sampling(fingerprint)
+    task arguments without the main job's later defaults get the values that run trained with
+    (`ARM_TASK_LEGACY_VALUES`: the task's own defaults)."""
+    fingerprint = _with_legacy_task_kwargs(fingerprint)
     if not isinstance(fingerprint.get("config"), dict):
         return fingerprint
     try:
@@ -78,17 +78,23 @@ def upgrade_fingerprint(fingerprint: dict) -> dict:
     return {**fingerprint, "config": config}
 
 
-def _with_target_sampling(fingerprint: dict) -> dict:
+# Task arguments the main job on the arm gained a default for, and what a run recorded without one
+# trained with: the uniform draw of targets (before the twelfth session) and fixed starts in
+# lessons 1-2 (before the thirteenth).
+ARM_TASK_LEGACY_VALUES = {"target_sampling": "uniform", "fixed_stored_starts": 0.0}
+
+
+def _with_legacy_task_kwargs(fingerprint: dict) -> dict:
     """``upgrade_fingerprint``'s part for the task arguments: only an arm run's, whose tasks all
-    take ``target_sampling`` (a dm_control task has no such argument)."""
+    take these arguments (a dm_control task has no such argument)."""
     task_kwargs = fingerprint.get("task_kwargs")
-    if not isinstance(task_kwargs, dict) or "target_sampling" in task_kwargs:
+    if not isinstance(task_kwargs, dict) or all(k in task_kwargs for k in ARM_TASK_LEGACY_VALUES):
         return fingerprint
     try:
         arm = all(as_domain(lesson.domain).is_arm for lesson in parse_plan(fingerprint.get("plan", "")))
     except (TypeError, ValueError):
         return fingerprint  # not a plan of this program: the comparison names what differs
-    return {**fingerprint, "task_kwargs": {**task_kwargs, "target_sampling": "uniform"}} if arm else fingerprint
+    return {**fingerprint, "task_kwargs": {**ARM_TASK_LEGACY_VALUES, **task_kwargs}} if arm else fingerprint
 
 
 def make_environment(domain, task: str, seed: int, **task_kwargs):
@@ -232,7 +238,8 @@ class CurriculumRun:
 
     def restore(self, path: Optional[str] = None):
         path = path or self.checkpoint_path
-        state = checkpoint.load(path, self.fingerprint(), upgrade=upgrade_fingerprint)
+        # Both sides upgraded: a task argument left out means the task's default, then as now.
+        state = checkpoint.load(path, upgrade_fingerprint(self.fingerprint()), upgrade=upgrade_fingerprint)
         loop = self.loop
         loop.learner.set_state(state["learner"])
         loop.actor.update(loop.learner.policy_params)

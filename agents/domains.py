@@ -167,7 +167,8 @@ class Domain:
         pose), minus every pose within `exclusion` (m) of the evaluation's moving starts, so the
         moving-start evaluation still starts where training never started."""
         if self.on_quadruped:
-            raise ValueError("stored_starts settles the arm holding stored inputs on the frame; "
+            raise ValueError("stored starts (stored_starts, fixed_stored_starts) settle the arm holding stored "
+                             "inputs on the frame; "
                              f"{self.name!r} stands on a quadruped, where it is not supported")
         from agents.lookup import lookup_table
         starts, _ = self.moving_starts()

@@ -122,13 +122,14 @@ def test_checkpoint_from_before_a_config_field_loads_as_its_run_had_it(tmp_path)
 
 
 def test_arm_checkpoint_from_before_failure_sampling_resumes_as_the_uniform_run_it_was(tmp_path):
-    """An arm run's fingerprint without target_sampling (before the main job drew targets by
-    failure) trained with the task's uniform draw: it resumes with '"target_sampling": "uniform"'
-    and is refused under today's failure draw, naming the difference; a dm_control run's task
-    arguments are left as they were."""
+    """An arm run's fingerprint without target_sampling and fixed_stored_starts (before the main
+    job drew targets by failure and started lessons 1-2 at stored poses) trained with the task's
+    uniform draw and fixed starts: it resumes with those and is refused under today's failure draw,
+    naming the difference; a run whose task arguments leave them out resumes as itself; a dm_control
+    run's task arguments are left as they were."""
     from agents.curriculum import upgrade_fingerprint
     plan = parse_plan("robostrich/lesson1:300")
-    uniform = {"weights": {"position_precision": 1.0}, "target_sampling": "uniform"}
+    uniform = {"weights": {"position_precision": 1.0}, "target_sampling": "uniform", "fixed_stored_starts": 0.0}
     config = SACConfig(**{**TINY.to_dict(), "hidden_sizes": (32, 32)})
     run = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300,
                         task_kwargs=uniform)
@@ -143,6 +144,12 @@ def test_arm_checkpoint_from_before_failure_sampling_resumes_as_the_uniform_run_
     failures = {**uniform, "target_sampling": "failures"}
     with pytest.raises(ValueError, match="target_sampling"):
         CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "c"), task_kwargs=failures).restore(path)
+    with pytest.raises(ValueError, match="fixed_stored_starts: checkpoint has 0.0, this run has 0.25"):
+        CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "d"),
+                      task_kwargs={**uniform, "fixed_stored_starts": 0.25}).restore(path)
+    # leaving an argument out means the task's default, in the checkpoint and in this run alike
+    CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "e"),
+                  task_kwargs={"weights": {"position_precision": 1.0}}).restore(path)
     dmc = {"plan": "reacher/easy:300", "task_kwargs": {"time_limit": 5}}
     assert upgrade_fingerprint(dmc) == dmc
 
@@ -249,13 +256,14 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     assert training.resolve_layout(None, arm) == "antagonist_pairs"
     assert training.resolve_layout("paper", arm) is None  # the tasks' own layout, as older checkpoints name it
     assert training.resolve_layout("ventral_slips", arm) == "ventral_slips" and training.resolve_layout(None, dmc) is None
-    assert training.resolve_task_kwargs({}, arm) == {"weights": {"position_precision": 1.0},
-                                                     "target_sampling": "failures"}
+    recipe = {"weights": {"position_precision": 1.0}, "target_sampling": "failures", "fixed_stored_starts": 0.25}
+    assert training.resolve_task_kwargs({}, arm) == recipe
     assert training.resolve_task_kwargs({"weights": {"position_error": 10}, "position_tolerance": 0.02}, arm) == {
-        "weights": {"position_precision": 1.0, "position_error": 10}, "position_tolerance": 0.02,
-        "target_sampling": "failures"}
-    assert training.resolve_task_kwargs({"weights": {"position_precision": 0}, "target_sampling": "uniform"},
-                                        arm) == {"weights": {"position_precision": 0}, "target_sampling": "uniform"}
+        **recipe, "weights": {"position_precision": 1.0, "position_error": 10}, "position_tolerance": 0.02}
+    paper = {"weights": {"position_precision": 0}, "target_sampling": "uniform", "fixed_stored_starts": 0}
+    assert training.resolve_task_kwargs(paper, arm) == paper
+    # the stored starts are the frame's poses: on the quadruped lessons 1-2 start fixed
+    assert training.resolve_task_kwargs({}, Domain("robostrich_a1")) == {**recipe, "fixed_stored_starts": 0.0}
     assert training.resolve_task_kwargs({}, dmc) == {}
     with pytest.raises(ValueError, match="target_entropy_per_action"):
         SACConfig(target_entropy_per_action=float("nan"))

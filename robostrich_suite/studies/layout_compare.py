@@ -153,8 +153,10 @@ def curriculum_success(case: Case, target_path: pathlib.Path, steps: int, seed: 
 
     per_lesson = max(steps // 3, 1)
     plan = parse_plan(",".join(f"lesson{i}:{per_lesson}" for i in (1, 2, 3)))
+    # Lessons 1-2 start fixed here: the main job's stored starts are one layout's stored poses.
+    task_kwargs = {**DEFAULT_ARM_TASK_KWARGS, "fixed_stored_starts": 0.0}
     run = CurriculumRun(plan, SACConfig(), seed, str(run_dir), checkpoint_every=10 ** 9,
-                        env_factory=env_factory, name=case.label, task_kwargs=DEFAULT_ARM_TASK_KWARGS)
+                        env_factory=env_factory, name=case.label, task_kwargs=task_kwargs)
     run.run()
     actor = SACBuilder.make_eval_actor(run.loop)
     return heldout_success(case, targets.heldout_targets(target_path), lambda flattener: actor)
