@@ -46,16 +46,17 @@ DEFAULT_ARM_LAYOUT = "antagonist_pairs"
 # "fixed_stored_starts": 0}' gives the paper's draw and starts. Evaluation keeps the task's defaults.
 DEFAULT_ARM_TASK_KWARGS = {"weights": {"position_precision": 1.0}, "target_sampling": "failures",
                            "fixed_stored_starts": 0.25}
-# The stored poses are the arm's on its frame (its lookup table): on the quadruped, lessons 1-2
-# start fixed.
-QUADRUPED_ARM_TASK_KWARGS = {**DEFAULT_ARM_TASK_KWARGS, "fixed_stored_starts": 0.0}
+# The same with lessons 1-2 starting fixed, where the stored poses (the frame arm's lookup table
+# for the layout trained) do not apply: on the quadruped, and for arms of other layouts
+# (robostrich-layouts --train).
+FIXED_START_ARM_TASK_KWARGS = {**DEFAULT_ARM_TASK_KWARGS, "fixed_stored_starts": 0.0}
 
 
 def default_task_kwargs(domain: Domain) -> dict:
     """The main job's task arguments on `domain` (none off the arm)."""
     if not domain.is_arm:
         return {}
-    return QUADRUPED_ARM_TASK_KWARGS if domain.on_quadruped else DEFAULT_ARM_TASK_KWARGS
+    return FIXED_START_ARM_TASK_KWARGS if domain.on_quadruped else DEFAULT_ARM_TASK_KWARGS
 
 
 def resolve_layout(layout: Optional[str], domain: Domain) -> Optional[str]:

@@ -64,6 +64,14 @@ class ArmIndices(NamedTuple):
     rk4: bool  # the model integrates with RK4 (dm_control's step then skips mj_step2)
 
 
+class ActuatorRangeViews(NamedTuple):
+    """Views into a model's actuator ranges for the arm's tendons (``ArmPhysicsMixin``'s per-step
+    readers): an edit of the model's ranges shows through them."""
+    control_low: np.ndarray  # m, the action spec's minimum
+    control_high: np.ndarray  # m, its maximum
+    pull_limit: np.ndarray  # actuator_forcerange's lower bound: minus the largest pull (N)
+
+
 def as_slice(ids) -> slice | np.ndarray:
     """``ids`` (non-negative) as a slice that reads the same elements in the same order
     where they are evenly spaced, else ``ids`` as an array: a slice reads a view without
@@ -216,9 +224,9 @@ class ArmPhysicsMixin:
         # Views into the model's actuator ranges for the per-step readers (an edit of the model's
         # ranges shows through a view); a copy would go stale, so only where ``select`` is a slice.
         model = data.model.ptr
-        self.__dict__["_range_views"] = (
-            (model.actuator_ctrlrange[select, 0], model.actuator_ctrlrange[select, 1],
-             model.actuator_forcerange[select, 0]) if isinstance(select, slice) else None)
+        self.__dict__["_range_views"] = ActuatorRangeViews(
+            model.actuator_ctrlrange[select, 0], model.actuator_ctrlrange[select, 1],
+            model.actuator_forcerange[select, 0]) if isinstance(select, slice) else None
 
     @property
     def arm_indices(self) -> ArmIndices:
@@ -277,8 +285,8 @@ class ArmPhysicsMixin:
     def tendon_tensions(self) -> np.ndarray:
         """Pull in each tendon as a fraction of its actuator's largest pull (0-1)."""
         select, views = self._indices.actuator_select, self._range_views
-        largest_pull = self._raw_model.actuator_forcerange[select, 0] if views is None else views[2]
-        return self._raw_data.actuator_force[select] / largest_pull
+        pull_limit = self._raw_model.actuator_forcerange[select, 0] if views is None else views.pull_limit
+        return self._raw_data.actuator_force[select] / pull_limit
 
     def arm_control(self) -> np.ndarray:
         return np.array(self._raw_data.ctrl[self._indices.actuator_select])
@@ -293,7 +301,7 @@ class ArmPhysicsMixin:
         instead of copying the (9, 2) range."""
         views = self._range_views
         if views is not None:
-            return views[0], views[1]
+            return views.control_low, views.control_high
         ctrlrange = self._raw_model.actuator_ctrlrange[self._indices.actuator_select]
         return ctrlrange[:, 0], ctrlrange[:, 1]
 

@@ -144,7 +144,7 @@ def curriculum_success(case: Case, target_path: pathlib.Path, steps: int, seed: 
     from agents.curriculum import CurriculumRun, make_environment, parse_plan
     from agents.sac.builder import SACBuilder
     from agents.sac.config import SACConfig
-    from agents.training import DEFAULT_ARM_TASK_KWARGS
+    from agents.training import FIXED_START_ARM_TASK_KWARGS
     arm_kwargs = dict(arm_spec=case.spec, tendon_layout=case.layout,
                       target_pool=targets.training_targets(target_path))
 
@@ -153,10 +153,8 @@ def curriculum_success(case: Case, target_path: pathlib.Path, steps: int, seed: 
 
     per_lesson = max(steps // 3, 1)
     plan = parse_plan(",".join(f"lesson{i}:{per_lesson}" for i in (1, 2, 3)))
-    # Lessons 1-2 start fixed here: the main job's stored starts are one layout's stored poses.
-    task_kwargs = {**DEFAULT_ARM_TASK_KWARGS, "fixed_stored_starts": 0.0}
     run = CurriculumRun(plan, SACConfig(), seed, str(run_dir), checkpoint_every=10 ** 9,
-                        env_factory=env_factory, name=case.label, task_kwargs=task_kwargs)
+                        env_factory=env_factory, name=case.label, task_kwargs=FIXED_START_ARM_TASK_KWARGS)
     run.run()
     actor = SACBuilder.make_eval_actor(run.loop)
     return heldout_success(case, targets.heldout_targets(target_path), lambda flattener: actor)
