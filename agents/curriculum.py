@@ -80,21 +80,32 @@ def upgrade_fingerprint(fingerprint: dict) -> dict:
 
 # Task arguments the main job on the arm gained a default for, and what a run recorded without one
 # trained with: the uniform draw of targets (before the twelfth session) and fixed starts in
-# lessons 1-2 (before the thirteenth).
+# lessons 1-2 (before the thirteenth); inside eq. 10's weights, no attitude-precision term (before
+# the fourteenth).
 ARM_TASK_LEGACY_VALUES = {"target_sampling": "uniform", "fixed_stored_starts": 0.0}
+ARM_WEIGHT_LEGACY_VALUES = {"attitude_precision": 0.0}
 
 
 def _with_legacy_task_kwargs(fingerprint: dict) -> dict:
     """``upgrade_fingerprint``'s part for the task arguments: only an arm run's, whose tasks all
     take these arguments (a dm_control task has no such argument)."""
     task_kwargs = fingerprint.get("task_kwargs")
-    if not isinstance(task_kwargs, dict) or all(k in task_kwargs for k in ARM_TASK_LEGACY_VALUES):
+    if not isinstance(task_kwargs, dict):
+        return fingerprint
+    weights = task_kwargs.get("weights")
+    missing_weights = isinstance(weights, dict) and not all(k in weights for k in ARM_WEIGHT_LEGACY_VALUES)
+    if all(k in task_kwargs for k in ARM_TASK_LEGACY_VALUES) and not missing_weights:
         return fingerprint
     try:
         arm = all(as_domain(lesson.domain).is_arm for lesson in parse_plan(fingerprint.get("plan", "")))
     except (TypeError, ValueError):
         return fingerprint  # not a plan of this program: the comparison names what differs
-    return {**fingerprint, "task_kwargs": {**ARM_TASK_LEGACY_VALUES, **task_kwargs}} if arm else fingerprint
+    if not arm:
+        return fingerprint
+    upgraded = {**ARM_TASK_LEGACY_VALUES, **task_kwargs}
+    if missing_weights:
+        upgraded["weights"] = {**ARM_WEIGHT_LEGACY_VALUES, **weights}
+    return {**fingerprint, "task_kwargs": upgraded}
 
 
 def make_environment(domain, task: str, seed: int, **task_kwargs):

@@ -154,6 +154,30 @@ def test_arm_checkpoint_from_before_failure_sampling_resumes_as_the_uniform_run_
     assert upgrade_fingerprint(dmc) == dmc
 
 
+def test_arm_checkpoint_from_before_the_attitude_precision_term_resumes_without_it(tmp_path):
+    """A fingerprint whose eq. 10 weights predate the attitude-precision default trained without
+    that term: it resumes where this run asks for 0 and is refused under today's 0.5, naming it."""
+    from agents.curriculum import upgrade_fingerprint
+    plan = parse_plan("robostrich/lesson2:300")
+    without = {"weights": {"position_precision": 1.0, "attitude_precision": 0.0}, "target_sampling": "uniform",
+               "fixed_stored_starts": 0.0}
+    config = SACConfig(**{**TINY.to_dict(), "hidden_sizes": (32, 32)})
+    run = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300,
+                        task_kwargs=without)
+    run.run()
+    old = run.fingerprint()
+    old["task_kwargs"] = {**without, "weights": {"position_precision": 1.0}}
+    assert upgrade_fingerprint(old)["task_kwargs"] == without
+    path = str(tmp_path / "old.pkl")
+    checkpoint.save(path, checkpoint.load(run.checkpoint_path), old)
+    resumed = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "b"), task_kwargs=without)
+    resumed.restore(path)
+    assert_same_run(resumed, run)
+    today = {**without, "weights": {"position_precision": 1.0, "attitude_precision": 0.5}}
+    with pytest.raises(ValueError, match="attitude_precision"):
+        CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "c"), task_kwargs=today).restore(path)
+
+
 def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
     plan = parse_plan("point_mass/easy:500,point_mass/hard:500")
     run = CurriculumRun(plan, TINY, seed=2, run_dir=str(tmp_path), checkpoint_every=10_000)
@@ -256,11 +280,14 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     assert training.resolve_layout(None, arm) == "antagonist_pairs"
     assert training.resolve_layout("paper", arm) is None  # the tasks' own layout, as older checkpoints name it
     assert training.resolve_layout("ventral_slips", arm) == "ventral_slips" and training.resolve_layout(None, dmc) is None
-    recipe = {"weights": {"position_precision": 1.0}, "target_sampling": "failures", "fixed_stored_starts": 0.25}
+    recipe = {"weights": {"position_precision": 1.0, "attitude_precision": 0.5}, "target_sampling": "failures",
+              "fixed_stored_starts": 0.25}
     assert training.resolve_task_kwargs({}, arm) == recipe
     assert training.resolve_task_kwargs({"weights": {"position_error": 10}, "position_tolerance": 0.02}, arm) == {
-        **recipe, "weights": {"position_precision": 1.0, "position_error": 10}, "position_tolerance": 0.02}
-    paper = {"weights": {"position_precision": 0}, "target_sampling": "uniform", "fixed_stored_starts": 0}
+        **recipe, "weights": {"position_precision": 1.0, "attitude_precision": 0.5, "position_error": 10},
+        "position_tolerance": 0.02}
+    paper = {"weights": {"position_precision": 0, "attitude_precision": 0}, "target_sampling": "uniform",
+             "fixed_stored_starts": 0}
     assert training.resolve_task_kwargs(paper, arm) == paper
     # the stored starts are the frame's poses: on the quadruped lessons 1-2 start fixed
     assert training.resolve_task_kwargs({}, Domain("robostrich_a1")) == {**recipe, "fixed_stored_starts": 0.0}

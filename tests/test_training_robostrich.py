@@ -72,8 +72,8 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
     assert recorded["plans"]["baseline"] == "robostrich/lesson3:750"
     # the main job's defaults on the arm: the layout it learns and the precision term (docs/learning.md)
     assert recorded["layout"] == "antagonist_pairs"
-    assert recorded["task_kwargs"] == {"weights": {"position_precision": 1.0}, "target_sampling": "failures",
-                                       "fixed_stored_starts": 0.25}
+    assert recorded["task_kwargs"] == {"weights": {"position_precision": 1.0, "attitude_precision": 0.5},
+                                       "target_sampling": "failures", "fixed_stored_starts": 0.25}
     assert recorded["config"]["her_lessons"] == ["lesson1"]
     assert recorded["config"]["her_ratio"] == 0.5 and recorded["config"]["her_level_goals"] is False
     reports = evaluation.main([os.path.join(out, "curriculum", "checkpoint.pkl"), "--out", str(tmp_path / "ev"),
