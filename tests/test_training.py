@@ -122,20 +122,23 @@ def test_checkpoint_from_before_a_config_field_loads_as_its_run_had_it(tmp_path)
 
 
 def test_arm_checkpoint_from_before_failure_sampling_resumes_as_the_uniform_run_it_was(tmp_path):
-    """An arm run's fingerprint without target_sampling and fixed_stored_starts (before the main
-    job drew targets by failure and started lessons 1-2 at stored poses) trained with the task's
-    uniform draw and fixed starts: it resumes with those and is refused under today's failure draw,
-    naming the difference; a run whose task arguments leave them out resumes as itself; a dm_control
+    """An arm run's fingerprint without target_sampling, fixed_stored_starts and the attitude-precision
+    weight (before the main job drew targets by failure, started lessons 1-2 at stored poses and
+    paid for a level head inside the tolerance) trained with the task's uniform draw, fixed starts
+    and no such term: it resumes with those and is refused under each of today's defaults, naming
+    the difference; a run whose task arguments leave them out resumes as itself; a dm_control
     run's task arguments are left as they were."""
     from agents.curriculum import upgrade_fingerprint
     plan = parse_plan("robostrich/lesson1:300")
-    uniform = {"weights": {"position_precision": 1.0}, "target_sampling": "uniform", "fixed_stored_starts": 0.0}
+    uniform = {"weights": {"position_precision": 1.0, "attitude_precision": 0.0}, "target_sampling": "uniform",
+               "fixed_stored_starts": 0.0}
     config = SACConfig(**{**TINY.to_dict(), "hidden_sizes": (32, 32)})
     run = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300,
                         task_kwargs=uniform)
     run.run()
     old = run.fingerprint()
     old["task_kwargs"] = {"weights": {"position_precision": 1.0}}
+    assert upgrade_fingerprint(old)["task_kwargs"] == uniform
     path = str(tmp_path / "old.pkl")
     checkpoint.save(path, checkpoint.load(run.checkpoint_path), old)
     resumed = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "b"), task_kwargs=uniform)
@@ -147,35 +150,15 @@ def test_arm_checkpoint_from_before_failure_sampling_resumes_as_the_uniform_run_
     with pytest.raises(ValueError, match="fixed_stored_starts: checkpoint has 0.0, this run has 0.25"):
         CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "d"),
                       task_kwargs={**uniform, "fixed_stored_starts": 0.25}).restore(path)
+    with pytest.raises(ValueError, match="attitude_precision"):
+        CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "f"),
+                      task_kwargs={**uniform, "weights": {"position_precision": 1.0, "attitude_precision": 0.5}}
+                      ).restore(path)
     # leaving an argument out means the task's default, in the checkpoint and in this run alike
     CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "e"),
                   task_kwargs={"weights": {"position_precision": 1.0}}).restore(path)
     dmc = {"plan": "reacher/easy:300", "task_kwargs": {"time_limit": 5}}
     assert upgrade_fingerprint(dmc) == dmc
-
-
-def test_arm_checkpoint_from_before_the_attitude_precision_term_resumes_without_it(tmp_path):
-    """A fingerprint whose eq. 10 weights predate the attitude-precision default trained without
-    that term: it resumes where this run asks for 0 and is refused under today's 0.5, naming it."""
-    from agents.curriculum import upgrade_fingerprint
-    plan = parse_plan("robostrich/lesson2:300")
-    without = {"weights": {"position_precision": 1.0, "attitude_precision": 0.0}, "target_sampling": "uniform",
-               "fixed_stored_starts": 0.0}
-    config = SACConfig(**{**TINY.to_dict(), "hidden_sizes": (32, 32)})
-    run = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300,
-                        task_kwargs=without)
-    run.run()
-    old = run.fingerprint()
-    old["task_kwargs"] = {**without, "weights": {"position_precision": 1.0}}
-    assert upgrade_fingerprint(old)["task_kwargs"] == without
-    path = str(tmp_path / "old.pkl")
-    checkpoint.save(path, checkpoint.load(run.checkpoint_path), old)
-    resumed = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "b"), task_kwargs=without)
-    resumed.restore(path)
-    assert_same_run(resumed, run)
-    today = {**without, "weights": {"position_precision": 1.0, "attitude_precision": 0.5}}
-    with pytest.raises(ValueError, match="attitude_precision"):
-        CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "c"), task_kwargs=today).restore(path)
 
 
 def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
