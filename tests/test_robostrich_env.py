@@ -604,3 +604,39 @@ def test_reward_and_observation_read_the_state_they_are_asked_about():
     for key in fresh:
         np.testing.assert_array_equal(handed_over[key], fresh[key])
     np.testing.assert_array_equal(fresh["head_position"], physics.head_position()[[0, 2]])
+
+
+@pytest.mark.parametrize("domain", ["robostrich", "robostrich_a1"])
+def test_per_step_views_read_their_own_physics_live_after_copy_and_unpickling(domain):
+    """The accessors read through views into the simulation's buffers (``ArmViews``): each
+    physics, copied or unpickled, reads its own live state after each step, equal to what the
+    raw MuJoCo data holds, and writes its controls into its own data only."""
+    env = robostrich_suite.load(domain, "lesson2", task_kwargs=dict(random=0))
+    env.reset()
+    copied, unpickled = env.physics.copy(share_model=False), pickle.loads(pickle.dumps(env.physics))
+    inputs = np.random.default_rng(1).uniform(*env.physics.arm_control_range().T, size=(3, 9))
+    for physics, action in zip((env.physics, copied, unpickled), inputs):
+        assert physics._views is not None  # the real models' indices are slices
+        before = [other.head_position() for other in (env.physics, copied, unpickled)]
+        physics.set_arm_control(action)
+        physics.step(20)
+        after = [other.head_position() for other in (env.physics, copied, unpickled)]
+        moved = [not np.array_equal(b, a) for b, a in zip(before, after)]
+        assert moved == [other is physics for other in (env.physics, copied, unpickled)]
+        indices, data = physics.arm_indices, physics.data
+        np.testing.assert_array_equal(physics.arm_control(), action)
+        np.testing.assert_array_equal(data.ctrl[indices.actuators], action)
+        np.testing.assert_array_equal(physics.head_position(), data.site_xpos[indices.head_site])
+        np.testing.assert_array_equal(physics.joint_angles(), data.qpos[indices.qpos])
+        np.testing.assert_array_equal(physics.tendon_lengths(), data.ten_length[indices.tendons])
+        np.testing.assert_array_equal(physics.tendon_forces(), -data.actuator_force[indices.actuators])
+        np.testing.assert_array_equal(physics.head_velocity(),
+                                      data.sensordata[indices.head_velocity:indices.head_velocity + 3])
+        axis = np.asarray(data.xmat[indices.head_body]).reshape(3, 3)[:, 2]
+        if domain == "robostrich":  # the frame's head turns in the x-z plane; modulo a turn
+            turned = physics.head_attitude() - np.degrees(np.arctan2(axis[0], axis[2]))
+            assert (turned + 180.0) % 360.0 - 180.0 == pytest.approx(0.0, abs=1e-9)
+        # What an accessor returns is a copy: a later step does not change it.
+        angles = physics.joint_angles()
+        physics.step(4)
+        assert not np.array_equal(angles, physics.joint_angles())

@@ -57,6 +57,20 @@ class RewardWeights:
                 + self.attitude_precision
                 * (1.0 - np.exp(-0.5 * (attitude_error_deg / self.attitude_precision_scale) ** 2)))
 
+    def precision_penalty_of_reading(self, position_error: float, attitude_error_deg: float) -> float:
+        """``precision_penalty`` of one step's reading, as a float and bit for bit the same (the
+        per-step reward): one numpy ``exp`` of both arguments instead of a dozen 0-d array
+        operations.  Each operation is the one ``precision_penalty`` does on numpy scalars:
+        ``** 2`` (libm's pow, not ``x * x``) and numpy's exp (not ``math.exp``); either swap
+        changes the last bit now and then, and a run would no longer repeat its rewards."""
+        position_scaled = position_error / self.precision_scale
+        attitude_scaled = attitude_error_deg / self.attitude_precision_scale
+        position_gauss, attitude_gauss = np.exp(
+            [-0.5 * position_scaled ** 2,
+             -0.5 * attitude_scaled ** 2]).tolist()
+        return (self.position_precision * (1.0 - position_gauss)
+                + self.attitude_precision * (1.0 - attitude_gauss))
+
     @property
     def largest_penalty(self) -> float:
         """The most a step can lose when both are missed far off (a diverged step costs twice this)."""
@@ -77,7 +91,7 @@ def lesson2_reward(position_error: float, attitude_error_deg: float, position_to
             - weights.attitude_miss * float(attitude_error_deg > attitude_tolerance_deg))
     r_a2 = -weights.position_error * position_error - weights.attitude_error * attitude_error_deg
     if weights.has_precision_terms:
-        r_a2 -= float(weights.precision_penalty(position_error, attitude_error_deg))
+        r_a2 -= weights.precision_penalty_of_reading(float(position_error), attitude_error_deg)
     return r_m2 + r_a2
 
 
