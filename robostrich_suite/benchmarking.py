@@ -13,7 +13,17 @@ class EnvLoop:
     each ``run`` continues where the last one stopped, so short timed rounds add up to episodes."""
 
     def __init__(self, domain: str, task: str, actions: np.ndarray):
-        self.env = robostrich_suite.load(domain, task, task_kwargs=dict(random=0))
+        self._start(robostrich_suite.load(domain, task, task_kwargs=dict(random=0)), actions)
+
+    @classmethod
+    def of(cls, env, actions: np.ndarray) -> "EnvLoop":
+        """The loop of any dm_env environment ``env`` (a baseline's)."""
+        loop = cls.__new__(cls)
+        loop._start(env, actions)
+        return loop
+
+    def _start(self, env, actions: np.ndarray) -> None:
+        self.env = env
         self.env.reset()
         self.actions, self.count = actions, 0
 

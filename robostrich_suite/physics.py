@@ -354,6 +354,12 @@ class ArmPhysicsMixin:
         ctrlrange = self._raw_model.actuator_ctrlrange[self._indices.actuator_select]
         return ctrlrange[:, 0], ctrlrange[:, 1]
 
+    def arm_control_view(self) -> np.ndarray | None:
+        """The arm's entries of the simulation's controls as a writable view (action order), for
+        the per-step action check to clip into; None where the model has no ``ArmViews``."""
+        views = self._views
+        return None if views is None else views.controls
+
     def set_arm_control(self, action) -> None:
         """Write tendon contractions to the arm's actuators only (a robot may have others)."""
         views = self._views

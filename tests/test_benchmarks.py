@@ -177,7 +177,8 @@ def test_input_sensitivity_stored_inputs_hold_their_targets_and_errors_cost_succ
 
 def test_env_benchmark_resets_its_raw_baseline_like_the_environment(capsys):
     """The raw mj_step baseline runs the same episodes as the environment (lesson 2: 250 control
-    steps from the fixed start), and the tool prints both rates and the median of its rounds' ratios."""
+    steps from the fixed start), as does the bare dm_control environment beside them, and the tool
+    prints the rates and the median of its rounds' ratios."""
     tool = load_tool("benchmark_env")
     from robostrich_suite import benchmarking
     assert benchmarking.episode_steps("robostrich", "lesson2") == 250
@@ -190,7 +191,11 @@ def test_env_benchmark_resets_its_raw_baseline_like_the_environment(capsys):
     wrapped.run(300)
     assert wrapped.env.physics.data.time == pytest.approx(50 * 0.008)
     np.testing.assert_array_equal(wrapped.env.physics.data.qpos, raw.data.qpos)  # the same episodes
+    bare = tool.bare_loop(actions)  # the plain dm_control floor runs them too
+    bare.run(300)
+    np.testing.assert_array_equal(bare.env.physics.data.qpos, raw.data.qpos)
     tool.main(["--steps", "100", "--rounds", "3"])
     lines = capsys.readouterr().out.splitlines()
-    ratio = float(lines[-1].split(":")[1].split()[0])
-    assert lines[0].startswith("raw mj_step") and "median of 3 rounds" in lines[-1] and 0.05 < ratio < 1.5
+    ratios = {line.split(":")[0].split()[1]: float(line.split(":")[1].split()[0]) for line in lines[-2:]}
+    assert lines[0].startswith("raw mj_step") and "median of 3 rounds" in lines[-1]
+    assert set(ratios) == {"bare/raw", "env/raw"} and all(0.05 < r < 1.5 for r in ratios.values())

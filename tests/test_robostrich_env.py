@@ -185,11 +185,19 @@ def test_malformed_actions_raise_naming_expected_and_received(domain, action, me
 def test_nan_action_raises_and_out_of_range_is_clipped():
     env = robostrich_suite.load("robostrich", "lesson1", task_kwargs=dict(random=0))
     env.reset()
+    spec = env.action_spec()
+    env.step(np.full(9, 0.01))
     action = np.zeros(9)
     action[4] = np.nan
     with pytest.raises(ValueError, match=r"non-finite values at indices \[4\]"):
         env.step(action)
-    spec = env.action_spec()
+    # The check clips straight into the simulation's controls, and writes nothing it rejects.
+    np.testing.assert_array_equal(env.physics.data.ctrl, np.minimum(0.01, spec.maximum))
+    with pytest.raises(ValueError, match=r"shape \(9,\), got shape \(8,\)"):
+        env.step(np.zeros(8))
+    np.testing.assert_array_equal(env.physics.data.ctrl, np.minimum(0.01, spec.maximum))
+    env.step(np.full(9, 1e-3, dtype=np.float32))  # float32 and ints clip like float64
+    np.testing.assert_array_equal(env.physics.data.ctrl, np.float64(np.float32(1e-3)))
     env.step(np.full(9, 10.0))
     np.testing.assert_array_equal(env.physics.data.ctrl, spec.maximum)
     env.step(np.full(9, -10.0))

@@ -2,13 +2,15 @@
 
     python tools/benchmark_env.py [--steps 1000] [--rounds 21]
 
-Both run the same MJCF with the same 4 physics substeps per control step, so
+All run the same MJCF with the same 4 physics substeps per control step, so
 the ratio is the cost of the dm_control wrapper, the task's observation and
-reward, and our per-step checks.  The CPU's speed drifts by several per cent
-from second to second (another process, its clock), so the two alternate in
-short rounds of ``--steps`` control steps and the ratio reported is the
-median of the rounds' ratios (each round's two halves ran within a second of
-each other), with its interquartile range.
+reward, and our per-step checks.  A bare dm_control environment of the same
+model (a task that only writes the action and returns the joint positions)
+runs beside them: the floor any dm_control task stands on.  The CPU's speed
+drifts by several per cent from second to second (another process, its
+clock), so the loops alternate in short rounds of ``--steps`` control steps
+and each ratio reported is the median of the rounds' ratios (each round's
+parts ran within a second of each other), with its interquartile range.
 """
 import argparse
 import os
@@ -18,8 +20,12 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
+from dm_control import mujoco as dm_mujoco  # noqa: E402
+from dm_control.rl import control  # noqa: E402
+from dm_control.suite import base  # noqa: E402
 
 from robostrich_suite import benchmarking, robostrich  # noqa: E402
+from robostrich_suite.tasks import conventions, lessons  # noqa: E402
 
 
 class RawLoop:
@@ -30,7 +36,7 @@ class RawLoop:
     def __init__(self, actions: np.ndarray, episode_steps: int):
         self.model = mujoco.MjModel.from_xml_string(robostrich.get_model_and_assets()[0])
         self.data = mujoco.MjData(self.model)
-        self.substeps = int(round(robostrich.CONTROL_TIMESTEP / self.model.opt.timestep))
+        self.substeps = int(round(conventions.CONTROL_TIMESTEP / self.model.opt.timestep))
         self.actions, self.episode_steps, self.count = actions, episode_steps, 0
 
     def run(self, steps: int) -> float:
@@ -47,6 +53,38 @@ class RawLoop:
         return time.perf_counter() - start
 
 
+class BareTask(base.Task):
+    """The least a dm_control task does: write the action, return one observation, a reward."""
+
+    def initialize_episode(self, physics):
+        pass
+
+    def before_step(self, action, physics):
+        physics.data.ctrl[:] = action
+
+    def get_observation(self, physics):
+        return {"joint_positions": physics.data.qpos.copy()}
+
+    def get_reward(self, physics):
+        return 0.0
+
+
+def bare_loop(actions: np.ndarray) -> benchmarking.EnvLoop:
+    """A plain dm_control environment of the same model with ``BareTask``: the same control
+    step and episodes (2 s from the model's initial state) as the lesson's."""
+    physics = dm_mujoco.Physics.from_xml_string(robostrich.get_model_and_assets()[0])
+    env = control.Environment(physics, BareTask(random=0), time_limit=lessons.LESSON_TIME_LIMIT,
+                              control_timestep=conventions.CONTROL_TIMESTEP)
+    return benchmarking.EnvLoop.of(env, actions)
+
+
+def _ratio_line(name: str, raw_seconds, seconds) -> str:
+    ratios = np.array(raw_seconds) / np.array(seconds)
+    low, median, high = np.percentile(ratios, [25, 50, 75])
+    return (f"ratio {name:9s}: {median:10.3f} (median of {len(ratios)} rounds; "
+            f"quartiles {low:.3f}-{high:.3f})")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--steps", type=int, default=1000, help="control steps per round and loop")
@@ -55,17 +93,21 @@ def main(argv=None):
     args = parser.parse_args(argv)
     actions = benchmarking.random_actions("robostrich", args.task)
     raw = RawLoop(actions, benchmarking.episode_steps("robostrich", args.task))
+    bare = bare_loop(actions)
     wrapped = benchmarking.EnvLoop("robostrich", args.task, actions)
-    raw.run(args.steps), wrapped.run(args.steps)  # warm caches and allocations
-    raw_seconds, env_seconds = [], []
+    loops = {"raw": raw, "bare": bare, "env": wrapped}
+    seconds = {name: [] for name in loops}
+    for loop in loops.values():
+        loop.run(args.steps)  # warm caches and allocations
     for _ in range(args.rounds):
-        raw_seconds.append(raw.run(args.steps))
-        env_seconds.append(wrapped.run(args.steps))
-    ratios = np.array(raw_seconds) / np.array(env_seconds)
-    low, median, high = np.percentile(ratios, [25, 50, 75])
-    print(f"raw mj_step x{raw.substeps} : {args.steps / min(raw_seconds):10.0f} control steps/s (best round)")
-    print(f"robostrich/{args.task}: {args.steps / min(env_seconds):10.0f} env steps/s (best round)")
-    print(f"ratio env/raw  : {median:10.3f} (median of {args.rounds} rounds; quartiles {low:.3f}-{high:.3f})")
+        for name, loop in loops.items():
+            seconds[name].append(loop.run(args.steps))
+    best = {name: args.steps / min(times) for name, times in seconds.items()}
+    print(f"raw mj_step x{raw.substeps} : {best['raw']:10.0f} control steps/s (best round)")
+    print(f"bare dm_control: {best['bare']:10.0f} env steps/s (best round)")
+    print(f"robostrich/{args.task}: {best['env']:10.0f} env steps/s (best round)")
+    print(_ratio_line("bare/raw", seconds["raw"], seconds["bare"]))
+    print(_ratio_line("env/raw", seconds["raw"], seconds["env"]))
 
 
 if __name__ == "__main__":

@@ -55,17 +55,23 @@ STORED_START_SETTLE_TIME = 2.0  # s
 RELEASE_TIME = 1.0  # s: releasing a neck curled back by a turn brings it up to level in 0.8 s
 
 
-def validate_action(action, size: int) -> np.ndarray:
-    """``action`` as a float64 vector of ``size`` real numbers, or a ValueError naming what was
-    expected and what came (a scalar must not silently drive every tendon, nor 8 values fail
-    deep inside numpy)."""
+def _real_vector(action, size: int) -> np.ndarray:
+    """``action`` as an array of ``size`` real numbers (not copied), or a ValueError naming
+    what was expected and what came (a scalar must not silently drive every tendon, nor 8
+    values fail deep inside numpy)."""
     array = np.asarray(action)
     if array.dtype.kind not in "iuf":  # not bool, complex, str, object (None), ...
         raise ValueError(f"action must be {size} real numbers (float), got dtype {array.dtype} "
                          f"({type(action).__name__})")
     if array.shape != (size,):
         raise ValueError(f"action must have shape ({size},), got shape {array.shape}")
-    return array.astype(np.float64)
+    return array
+
+
+def validate_action(action, size: int) -> np.ndarray:
+    """``action`` as a new float64 vector of ``size`` real numbers, or a ValueError naming what
+    was expected and what came."""
+    return _real_vector(action, size).astype(np.float64)
 
 
 def _hold_before_episode(physics, inputs, seconds: float) -> None:
@@ -106,21 +112,25 @@ def check_time_limit(time_limit) -> float:
     return float(time_limit)
 
 
-def check_action(action: np.ndarray, bounds) -> np.ndarray:
+def check_action(action: np.ndarray, bounds, out: np.ndarray | None = None) -> np.ndarray:
     """Reject actions of the wrong shape or type and NaN/inf; clip the rest into ``bounds``,
-    the (low, high) arrays ``physics.arm_control_bounds()`` gives."""
+    the (low, high) arrays ``physics.arm_control_bounds()`` gives.  The clipped action goes
+    into ``out`` where given (the simulation's controls: the per-step path), else a new array;
+    nothing is written unless the action is valid."""
     low, high = bounds
-    action = validate_action(action, len(low))
+    array = _real_vector(action, len(low))
     # One dot product is finite when every entry is (and small enough that squares stay
     # finite, which real tendon inputs are); only otherwise look at each entry.
-    if not math.isfinite(action.dot(action)):
-        finite = np.isfinite(action)
+    if not math.isfinite(array.dot(array)):
+        finite = np.isfinite(array)
         if not finite.all():
             bad = np.flatnonzero(~finite).tolist()
-            raise ValueError(f"action has non-finite values at indices {bad}: {action}")
-    # np.clip's result, in place on validate_action's copy (this runs every control step)
-    np.maximum(action, low, out=action)
-    return np.minimum(action, high, out=action)
+            raise ValueError(f"action has non-finite values at indices {bad}: {array}")
+    # np.clip's result (in float64 whatever came), by two in-place steps: a third of its cost
+    if out is None:
+        out = np.empty(len(low))
+    np.maximum(array, low, out=out)
+    return np.minimum(out, high, out=out)
 
 
 class Reach(base.Task):
@@ -332,7 +342,11 @@ class Reach(base.Task):
 
     def before_step(self, action, physics):
         self._head_reading = None
-        physics.set_arm_control(check_action(action, physics.arm_control_bounds()))
+        controls = physics.arm_control_view()
+        if controls is None:
+            physics.set_arm_control(check_action(action, physics.arm_control_bounds()))
+        else:  # checked and clipped straight into the simulation's controls
+            check_action(action, physics.arm_control_bounds(), out=controls)
 
     def after_step(self, physics):
         self._head_reading = None
@@ -347,13 +361,14 @@ class Reach(base.Task):
         return physics.head_position()[self._target_axes_index]
 
     def _read_head(self, physics) -> tuple:
-        """(head x-z, attitude in deg) for ``get_observation``.  ``get_reward`` always reads the
-        head afresh and keeps its reading for the ``get_observation`` that dm_control calls next
-        in the same step, which uses it once (a step or a new episode drops it): the attitude is
-        a step's costliest reading."""
+        """(head x-z, attitude in deg, target minus head) for ``get_observation``.
+        ``get_reward`` always reads the head afresh and keeps its reading for the
+        ``get_observation`` that dm_control calls next in the same step, which uses it once (a
+        step or a new episode drops it): the attitude is a step's costliest reading."""
         reading = self._head_reading
         if reading is None:
-            return self.head_xz(physics), physics.head_attitude()
+            head = self.head_xz(physics)
+            return head, physics.head_attitude(), self.target_position - head
         self._head_reading = None
         return reading
 
@@ -407,7 +422,7 @@ class Reach(base.Task):
         """
         obs = {}  # ordered by insertion, as dm_control's specs and our flattener read it (an
         # OrderedDict costs about a microsecond more per step)
-        head, attitude = self._read_head(physics)
+        head, attitude, to_target = self._read_head(physics)
         obs["head_position"] = head
         obs["head_velocity"] = physics.head_velocity()[self._target_axes_index]
         joint_angles = physics.joint_angles()
@@ -415,7 +430,7 @@ class Reach(base.Task):
             joint_angles = self.randomizer.observe_joint_angles(joint_angles, self.random)
         obs["joint_angles"] = joint_angles
         obs["target_position"] = self.target_position.copy()
-        obs["to_target"] = self.target_position - head
+        obs["to_target"] = to_target
         attitude_error = physics_lib.attitude_error_deg(attitude, self.desired_attitude)
         obs["attitude_error"] = np.array([math.radians(attitude_error)])
         obs["head_attitude"] = np.array([math.radians(attitude)])
@@ -430,8 +445,11 @@ class Reach(base.Task):
         if physics.divergence is not None:
             self._last_reached = None
             return -2.0 if self.reward_name == "lesson1" else -2.0 * self.weights.largest_penalty
-        head, attitude = self._head_reading = self.head_xz(physics), physics.head_attitude()
-        error = _length(self.target_position - head)  # position_error, on this reading
+        head = self.head_xz(physics)
+        to_target = self.target_position - head
+        attitude = physics.head_attitude()
+        self._head_reading = head, attitude, to_target
+        error = _length(to_target)  # position_error, on this reading
         if self.reward_name == "lesson1":
             if self._samples_failures():
                 self._last_reached = self._within_tolerances(error)  # eq. 9 asks for the position alone
