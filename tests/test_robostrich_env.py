@@ -648,3 +648,14 @@ def test_per_step_views_read_their_own_physics_live_after_copy_and_unpickling(do
         angles = physics.joint_angles()
         physics.step(4)
         assert not np.array_equal(angles, physics.joint_angles())
+    # A model whose arm indices are no slices reads without views: the same values.
+    physics = env.physics
+    names = ("head_position", "head_velocity", "head_attitude", "joint_angles", "tendon_lengths",
+             "tendon_contractions", "tendon_forces", "tendon_tensions", "arm_control", "arm_control_bounds")
+    through_views = {name: getattr(physics, name)() for name in names}
+    views, physics.__dict__["_views"] = physics._views, None
+    for name in names:
+        np.testing.assert_array_equal(getattr(physics, name)(), through_views[name], err_msg=name)
+    assert physics.arm_control_view() is None
+    env.task.before_step(np.full(9, 1e-3), physics)  # checked, clipped, written without the view
+    np.testing.assert_array_equal(views.controls, 1e-3)
