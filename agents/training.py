@@ -93,6 +93,16 @@ def check_task_kwargs(plan, layout, task_kwargs: dict) -> None:
         env.close()
 
 
+def check_action_change(task_kwargs: dict, config: SACConfig) -> None:
+    """The reward's action-change term depends on the action, not the goal: rewards the replay
+    recomputes for goals (hindsight, ``relabel_rewards``) would silently drop it, so it needs both off."""
+    weights = task_kwargs.get("weights")
+    change = weights.get("action_change", 0) if isinstance(weights, dict) else getattr(weights, "action_change", 0)
+    if change and (config.relabel_rewards or config.her_ratio > 0):
+        raise ValueError("--task-kwargs weights.action_change needs the replay to keep the rewards the task "
+                         "gave (recomputing them for goals drops the term): add --no-relabel-rewards --her-ratio 0")
+
+
 def lesson_text(run) -> str:
     """'2/3': the lesson a run is in, for the progress bar."""
     return f"{run.lesson_index + 1 if not run.done else len(run.plan)}/{len(run.plan)}"
@@ -479,6 +489,7 @@ def main(argv=None):
     for lesson in plan:  # a typo fails now, not after the first lessons have trained
         Domain(lesson.domain).check_task(lesson.task)
     check_task_kwargs(plan, args.layout, args.task_kwargs)
+    check_action_change(args.task_kwargs, config)
     check_lesson_names(plan, config, args.layout)
     heldout_task = args.heldout_task or domain.heldout_task(final.task)
     track_task = domain.track_task(args.track_task)

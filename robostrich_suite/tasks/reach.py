@@ -148,6 +148,7 @@ class Reach(base.Task):
     release_time = RELEASE_TIME
     _head_reading = None
     _continues_from_physics = False  # see _continuing_state
+    _action_change = 0.0  # mean |change| of the tendon inputs at the last step (m), see RewardWeights
 
     def __init__(self, reward: str = "lesson2", initial_state: str = "fixed",
                  target_pool=None, position_tolerance: float = POSITION_TOLERANCE,
@@ -244,6 +245,7 @@ class Reach(base.Task):
     # --- episode structure -------------------------------------------------
     def initialize_episode(self, physics):
         self._head_reading = None
+        self._action_change = 0.0
         if self._samples_failures():  # before anything moves the physics
             self._count_previous_episode()
         if self.randomizer is not None:
@@ -342,6 +344,14 @@ class Reach(base.Task):
 
     def before_step(self, action, physics):
         self._head_reading = None
+        if self.weights.action_change:  # the inputs before this step, for the action-change term
+            previous = physics.arm_control()
+            self._set_action(action, physics)
+            self._action_change = float(np.mean(np.abs(physics.arm_control() - previous)))
+        else:
+            self._set_action(action, physics)
+
+    def _set_action(self, action, physics) -> None:
         controls = physics.arm_control_view()
         if controls is None:
             physics.set_arm_control(check_action(action, physics.arm_control_bounds()))
@@ -457,8 +467,11 @@ class Reach(base.Task):
         attitude_error = physics_lib.attitude_error_deg(attitude, self.desired_attitude)
         if self._samples_failures():
             self._last_reached = self._within_tolerances(error, attitude_error)
-        return rewards.lesson2_reward(error, attitude_error, self.position_tolerance, self.attitude_tolerance,
-                                      self.weights)
+        reward = rewards.lesson2_reward(error, attitude_error, self.position_tolerance, self.attitude_tolerance,
+                                        self.weights)
+        if self.weights.action_change:
+            reward -= self.weights.action_change * self._action_change
+        return reward
 
 
 class Track(Reach):

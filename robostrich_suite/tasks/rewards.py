@@ -24,6 +24,13 @@ class RewardWeights:
     of the position error (``s = precision_scale``, m) or the attitude error
     (``s = attitude_precision_scale``, deg), which keeps paying for precision inside
     the tolerance, where eq. 10 pays only its shaping (2 per metre, 0.02 per degree).
+
+    ``action_change`` (per metre, not in the paper; 0 by default) weighs the mean absolute change
+    of the tendon inputs from one control step to the next in eq. 10's reward: a policy that
+    shakes its inputs at the control rate (as lesson 4 taught on the quadruped,
+    ``docs/quadruped.md``) pays for it.  It depends on the action, not on the goal, so replayed
+    rewards recomputed for other goals (hindsight, ``relabel_rewards``) cannot keep it: the agent
+    refuses it with either on.
     """
     position_miss: float = 1.0
     attitude_miss: float = 1.0
@@ -33,6 +40,7 @@ class RewardWeights:
     precision_scale: float = 0.01
     attitude_precision: float = 0.0
     attitude_precision_scale: float = 1.0
+    action_change: float = 0.0
 
     def __post_init__(self):
         for field in dataclasses.fields(self):
