@@ -153,6 +153,8 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
                              "--out", tmp_path / "tk"),
         "lesson_names": start("robostrich-train", "--long-horizon-lessons", "lesson9", "--quiet",
                               "--out", tmp_path / "ln"),
+        "action_change": start("robostrich-train", "--task-kwargs", '{"weights": {"action_change": 50}}',
+                               "--quiet", "--out", tmp_path / "ac"),
     }
     results = {case: finish(p) for case, p in cases.items()}
     assert_user_error(results["resume_empty"], "--resume", "no checkpoint", str(empty))
@@ -171,8 +173,11 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     assert not (tmp_path / "tk").exists()
     assert_user_error(results["lesson_names"], "long_horizon_lessons names ['lesson9']")
     assert not (tmp_path / "ln").exists()
+    # The action-change term would be dropped by the default recomputed rewards: refused, named.
+    assert_user_error(results["action_change"], "weights.action_change", "--no-relabel-rewards --her-ratio 0")
+    assert not (tmp_path / "ac").exists()
     for case in ("resume_empty", "truncated", "empty", "ramp_negative", "layout", "task", "xml_no_out",
-                 "task_kwargs", "lesson_names"):
+                 "task_kwargs", "lesson_names", "action_change"):
         assert results[case].returncode == 2, (case, results[case].stderr)
 
 

@@ -141,6 +141,25 @@ def test_precision_term_pays_inside_the_tolerance():
         rewards.RewardWeights(position_precision=float("nan"))
 
 
+def test_action_change_term_charges_the_inputs_change_per_step():
+    """With ``weights.action_change`` the reward drops by the weight times the mean |change| of the
+    tendon inputs written this step (after clipping, so a request beyond the range costs only what
+    moved); a repeated input costs nothing, and the weight 0 default leaves the reward as it was."""
+    weights = dict(position_precision=1.0, attitude_precision=0.5)
+    charged = robostrich_suite.load("robostrich", "lesson2",
+                                    task_kwargs=dict(random=0, weights={**weights, "action_change": 50.0}))
+    plain = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=0, weights=weights))
+    charged.reset(), plain.reset()
+    high = charged.action_spec().maximum
+    for action in (np.zeros(9), np.full(9, 0.004), np.full(9, 0.004), np.full(9, 1.0), np.zeros(9)):
+        before = charged.physics.arm_control()
+        difference = charged.step(action).reward - plain.step(action).reward
+        moved = np.mean(np.abs(charged.physics.arm_control() - before))
+        assert difference == pytest.approx(-50.0 * moved, abs=1e-12)
+        np.testing.assert_array_equal(charged.physics.data.qpos, plain.physics.data.qpos)  # same motion
+    assert moved == pytest.approx(np.mean(high))  # the last step: from the clipped maximum back to 0
+
+
 def _rollout(seed, actions):
     env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=seed))
     ts = env.reset()
