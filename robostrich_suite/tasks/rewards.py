@@ -81,7 +81,8 @@ class RewardWeights:
 
     @property
     def largest_penalty(self) -> float:
-        """The most a step can lose when both are missed far off (a diverged step costs twice this)."""
+        """The most a step can lose when both are missed far off (a diverged step costs twice this),
+        not counting ``action_change``: a divergence is charged on the head, whatever the inputs did."""
         return self.position_miss + self.attitude_miss + self.position_precision + self.attitude_precision
 
 
