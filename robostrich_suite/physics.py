@@ -184,7 +184,7 @@ def attitude_error_deg(attitude_deg, desired_deg):
 
 def _continuous_attitude(axis_angle_rad: float, joint_angles_rad: np.ndarray) -> float:
     """:func:`continuous_attitude_deg` of one pose in plain floats (same result): the
-    physics accessors run it twice per control step."""
+    physics accessors run it once per control step."""
     axis_angle = math.degrees(axis_angle_rad)
     # The sum only chooses the whole number of turns, so its rounding never shows: a Python
     # sum of the list is half the cost of numpy's on 18 numbers.
