@@ -24,7 +24,7 @@ def _parser(description: str, out: str) -> argparse.ArgumentParser:
                              "without it only zero input and the lookup run")
     parser.add_argument("--reference", default=None, metavar="CHECKPOINT",
                         help="a second checkpoint to compare (label 'reference'), e.g. lessons 1-3 without lesson 4")
-    parser.add_argument("--layout", default=None, help="built-in tendon layout (default: the checkpoints', else the paper's)")
+    parser.add_argument("--layout", default=None, help="built-in tendon layout (default: the checkpoints', else the tasks' own)")
     parser.add_argument("--seeds", type=cli_lib.whole_number(1), default=5,
                         help="gait phases: seed k of N starts the gait k/(2N) of its period later (default 5)")
     parser.add_argument("--gait", default=None, metavar="CSV",

@@ -56,11 +56,30 @@ def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, task_kwar
     identity = {"config": config.to_dict(), "plan": format_plan(plan), "seed": seed}
     if task_kwargs:
         identity["task_kwargs"] = dict(task_kwargs)
+    layout = named_layout(layout, plan)
     if layout is not None:
         identity["layout"] = layout
     if init_from is not None:
         identity["init_from"] = init_from
     return identity
+
+
+# Arm checkpoints that name no tendon layout were trained on the tasks' routing of their day, the one
+# now called ventral_from_base (the default became ventral_slips on 2026-12-02); runs since name theirs.
+LEGACY_UNNAMED_LAYOUT = "ventral_from_base"
+
+
+def _is_arm_plan(plan) -> bool:
+    return bool(plan) and all(as_domain(lesson.domain).is_arm for lesson in plan)
+
+
+def named_layout(layout: Optional[str], plan) -> Optional[str]:
+    """The tendon layout a run on ``plan`` trains, by name: ``layout``, or the tasks' default on
+    the arm domains (None off them)."""
+    if layout is not None or not _is_arm_plan(plan):
+        return layout
+    from robostrich_suite.model import layouts
+    return layouts.DEFAULT
 
 
 def upgrade_fingerprint(fingerprint: dict) -> dict:
@@ -69,6 +88,12 @@ def upgrade_fingerprint(fingerprint: dict) -> dict:
     task arguments without the main job's later defaults get the values that run trained with
     (`ARM_TASK_LEGACY_VALUES`: the task's own defaults)."""
     fingerprint = _with_legacy_task_kwargs(fingerprint)
+    if "layout" not in fingerprint:
+        try:
+            if _is_arm_plan(parse_plan(fingerprint.get("plan", ""))):
+                fingerprint = {**fingerprint, "layout": LEGACY_UNNAMED_LAYOUT}
+        except (TypeError, ValueError):
+            pass  # not a plan of this program: the comparison names what differs
     if not isinstance(fingerprint.get("config"), dict):
         return fingerprint
     try:
@@ -97,7 +122,7 @@ def _with_legacy_task_kwargs(fingerprint: dict) -> dict:
     if all(k in task_kwargs for k in ARM_TASK_LEGACY_VALUES) and not missing_weights:
         return fingerprint
     try:
-        arm = all(as_domain(lesson.domain).is_arm for lesson in parse_plan(fingerprint.get("plan", "")))
+        arm = _is_arm_plan(parse_plan(fingerprint.get("plan", "")))
     except (TypeError, ValueError):
         return fingerprint  # not a plan of this program: the comparison names what differs
     if not arm:

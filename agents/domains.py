@@ -31,11 +31,14 @@ def arm_domains() -> Tuple[str, ...]:
 
 @dataclasses.dataclass(frozen=True)
 class Domain:
-    """A domain name plus, on the arm, an optional built-in tendon layout."""
+    """A domain name plus, on the arm, a built-in tendon layout (default: the tasks' own)."""
     name: str
     layout: Optional[str] = None
 
     def __post_init__(self):
+        if self.layout is None and self.is_arm:  # the tasks' own routing, by name
+            from robostrich_suite.model import layouts
+            object.__setattr__(self, "layout", layouts.DEFAULT)
         if self.layout is not None:
             if not self.is_arm:
                 raise ValueError(f"--layout applies to the arm domains {list(arm_domains())}, "
@@ -82,7 +85,7 @@ class Domain:
     # -- environments ------------------------------------------------------------------------
     def _target_file(self):
         from robostrich_suite.model import layouts
-        return layouts.target_file(self.layout or layouts.DEFAULT)
+        return layouts.target_file(self.layout)
 
     def _to_domain_frame(self, frame_targets) -> np.ndarray:
         """Targets of the frame arm in this domain's coordinates (the trunk frame on the quadruped)."""

@@ -271,9 +271,9 @@ def _json_default(o):
 def load_run_from_checkpoint(path: str):
     """Rebuild the CurriculumRun that wrote `path` (its fingerprint holds config, plan and seed)."""
     from agents import checkpoint
-    from agents.curriculum import CurriculumRun, parse_plan
+    from agents.curriculum import CurriculumRun, parse_plan, upgrade_fingerprint
     from agents.sac.config import SACConfig
-    fp = checkpoint.read_fingerprint(path)
+    fp = upgrade_fingerprint(checkpoint.read_fingerprint(path))
     scratch = tempfile.mkdtemp(prefix="robostrich-evaluate-")  # the run's own files are left untouched
     try:
         run = CurriculumRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch,

@@ -206,7 +206,7 @@ def _single_domain(plan, what: str) -> str:
 def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = None, record=None) -> InitSource:
     """Everything that can be checked before building the run: a readable checkpoint, of a domain that can
     start `plan`'s, with the same tendon layout and networks.  TransferError (FileNotFoundError) otherwise."""
-    from agents.curriculum import parse_plan
+    from agents.curriculum import named_layout, parse_plan, upgrade_fingerprint
     if record is None:
         record, digest = _read(path)
     else:
@@ -218,10 +218,11 @@ def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = Non
     source_domain = _single_domain(parse_plan(fingerprint["plan"]), f"the plan of {path}")
     target_domain = _single_domain(plan, "this run's plan")
     correspondence(source_domain, target_domain)
-    if fingerprint.get("layout") != layout:
-        raise TransferError(f"--init-from: {path} was trained with tendon layout "
-                            f"{fingerprint.get('layout') or 'paper'!r}, this run uses {layout or 'paper'!r} "
-                            f"(pass --layout {fingerprint.get('layout') or 'paper'})")
+    source_layout = upgrade_fingerprint(fingerprint).get("layout")
+    layout = named_layout(layout, plan)
+    if source_layout != layout:
+        raise TransferError(f"--init-from: {path} was trained with tendon layout {source_layout!r}, "
+                            f"this run uses {layout!r} (pass --layout {source_layout})")
     for field in NETWORK_FIELDS:  # read from the dict: another run's config may have other fields
         a, b = fingerprint["config"].get(field, getattr(SACConfig(), field)), getattr(config, field)
         a = tuple(a) if isinstance(a, list) else a

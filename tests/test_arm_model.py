@@ -48,12 +48,38 @@ def test_masses_match_table1(physics):
 
 
 def test_default_layout_is_one_dorsal_and_eight_ventral():
+    """The tasks' arm is the reconstruction of Fig. 1B: one dorsal tendon to the head, eight
+    ventral slips at the paper's insertion levels; the model the suite loads has just these."""
     layout = arm.TendonLayout.robostrich()
+    assert layout == arm.TendonLayout.ventral_slips(span=4)
     assert [t.side for t in layout.tendons] == ["dorsal"] + ["ventral"] * 8
-    assert layout.tendons[0].insertion == "atlas"
+    assert layout.tendons[0].insertion == "atlas" and layout.tendons[0].on_base
     assert [t.insertion for t in layout.tendons[1:]] == list(
         arm.TendonLayout.ROBOSTRICH_VENTRAL_INSERTIONS)
-    assert all(t.links[0] == "c18" for t in layout.tendons)
+    model = Physics.from_xml_string(*get_model_and_assets()).model
+    assert physics_lib.tendon_sides(model) == ["dorsal"] + ["ventral"] * 8
+    from_base = arm.TendonLayout.ventral_from_base()
+    assert all(t.links[0] == "c18" and t.on_base for t in from_base.tendons)
+    assert [t.insertion for t in from_base.tendons] == [t.insertion for t in layout.tendons]
+
+
+def test_links_do_not_pass_through_each_other():
+    """Links two or more joints apart collide (as vertebrae do), except where their capsules
+    already touch with the neck straight; parent and child never do."""
+    spec = arm.ArmSpec.from_table1()
+    physics = Physics.from_xml_string(*get_model_and_assets())
+    assert arm.touching_link_pairs(spec) == [("c3", "atlas")]  # link C2 (7.1 mm) is shorter than the radii
+    physics.reset()
+    physics.forward()
+    assert physics.data.ncon == 0  # the straight neck touches nothing
+    # Bend C9 and C6 far ventral, past their limits, so that C10's and C6's capsules cross:
+    # the contact pushes them apart (without it they would overlap by over a centimetre).
+    with physics.reset_context():
+        physics.named.data.qpos[["arm/c9", "arm/c8", "arm/c7"]] = 1.3
+    geoms = {physics.model.id2name(int(g), "geom") for c in physics.data.contact[:physics.data.ncon]
+             for g in (c.geom1, c.geom2)}
+    assert physics.data.ncon > 0 and geoms <= {f"arm/{n}_geom" for n in spec.joint_names}
+    assert min(c.dist for c in physics.data.contact[:physics.data.ncon]) < -0.005
 
 
 def test_every_tendon_only_pulls(physics):

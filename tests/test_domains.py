@@ -58,7 +58,7 @@ def test_bad_domain_layout_and_task_names_are_errors_that_name_them():
     with pytest.raises(ValueError, match="unknown layout 'tangled'.*antagonist_pairs"):
         Domain("robostrich", "tangled")
     with pytest.raises(ValueError, match="arm domains.*'reacher'"):
-        Domain("reacher", "paper")
+        Domain("reacher", "ventral_slips")
     with pytest.raises(ValueError, match="no task 'lesson9'.*lesson1"):
         Domain("robostrich").check_task("lesson9")
     with pytest.raises(ValueError, match="unknown domain 'robostrch'.*robostrich"):

@@ -1,4 +1,5 @@
 """Tendon-layout comparison (issue 13): layout files, the coverage metric, robostrich-layouts."""
+import csv
 import json
 import os
 import subprocess
@@ -153,12 +154,44 @@ def test_the_better_layout_ships_with_its_own_targets_loadable_through_task_kwar
     spec = arm.ArmSpec.from_table1()
     assert str(targets.level_head_poses(path)["fingerprint"]) == fingerprint_lib.model_fingerprint(
         spec, layouts.build("antagonist_pairs"))
-    assert layouts.target_file("paper") == targets.DATA_PATH  # the tasks' default stays
+    assert layouts.target_file("ventral_slips") == targets.DATA_PATH  # the tasks' default
+    with pytest.raises(ValueError, match="'paper' is now called 'ventral_from_base'"):
+        layouts.target_file("paper")
+    from_base = layouts.target_file("ventral_from_base")
+    assert str(targets.level_head_poses(from_base)["fingerprint"]) == fingerprint_lib.model_fingerprint(
+        spec, layouts.build("ventral_from_base"))
     env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=layouts.task_kwargs("antagonist_pairs"))
     assert env.action_spec().shape == (9,)
     assert len(env.task.target_pool) == len(targets.training_targets(path)) > 0
     with pytest.raises(FileNotFoundError, match="no target file ships for layout 'cranial_every'"):
         layouts.target_file("cranial_every")
+
+
+def test_the_fig1b_candidates_are_the_routings_with_the_papers_tendons():
+    """One dorsal tendon to the head and eight ventral tendons at C16, C14, ..., C2, whatever
+    their caudal ends: the default first; our own routings are not candidates."""
+    candidates = layouts.fig1b_candidates()
+    assert candidates[0] == layouts.DEFAULT == "ventral_slips"
+    assert {"ventral_from_base", "ventral_slips_2", "ventral_slips_6"} <= set(candidates)
+    assert not {"antagonist_pairs", "second_dorsal", "cranial_every"} & set(candidates)
+    spans = {name: [len(t.links) for t in layouts.build(name).tendons[1:]] for name in candidates}
+    assert spans["ventral_slips"][2:] == [5] * 6  # each slip runs through 5 holes: 4 joints
+    assert len(set(map(tuple, spans.values()))) == len(candidates)  # each routed another way
+
+
+def test_the_fidelity_check_prints_the_candidates_table(tmp_path):
+    """`--candidates` measures every candidate of Fig. 1B, the rolling/lever test included."""
+    out = tmp_path / "out"
+    result = run_layouts("--out", out, "--candidates", "--kinematic-samples", 2000, "--random-samples", 1,
+                         "--seek-time", 0.1, "--no-lookup", "--no-progress", "--workers", 2)
+    assert result.returncode == 0, result.stderr[-3000:]
+    rows = {row["layout"]: row for row in csv.DictReader(open(out / "layouts.csv"))}
+    assert list(rows) == layouts.fig1b_candidates()
+    # The paper's difference: rolling keeps the attitude at equal head travel on the default,
+    # and does not on the routing with every ventral tendon from the base.
+    assert float(rows["ventral_slips"]["rolling_lever_ratio"]) < 0.6
+    assert float(rows["ventral_from_base"]["rolling_lever_ratio"]) > 1.0
+    assert "head travel (mm)" in result.stdout and "| ventral_slips |" in result.stdout
 
 
 def run_layouts(*args):

@@ -9,7 +9,7 @@ its head travel equals the rolling pattern's), measured:
 
 so the rolling pattern keeps the attitude range at 0.42 of the lever's: the
 paper's difference.  On the tasks' arm (every ventral tendon from the base, dorsal
-*length* held, ``movement.PAPER_LAYOUT``) the difference does not appear: rolling
+*length* held, ``movement.FROM_BASE``) the difference does not appear: rolling
 25.0 deg / 190 mm, lever 25.4 deg / 191 mm, because there the settled poses form a
 one-parameter family whose attitude is a function of the head position (tested
 below); numbers and reasons in docs/movement.md.
@@ -23,7 +23,7 @@ from robostrich_suite.studies import movement
 @pytest.fixture(scope="module")
 def runs():
     """The paper's layout: ventral tendons from the base, dorsal length held."""
-    return {pattern: movement.run(movement.MovementConfig(pattern, **movement.PAPER_LAYOUT))
+    return {pattern: movement.run(movement.MovementConfig(pattern, **movement.FROM_BASE))
             for pattern in movement.PATTERNS}
 
 

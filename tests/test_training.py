@@ -159,6 +159,17 @@ def test_arm_checkpoint_from_before_failure_sampling_resumes_as_the_uniform_run_
                   task_kwargs={"weights": {"position_precision": 1.0}}).restore(path)
     dmc = {"plan": "reacher/easy:300", "task_kwargs": {"time_limit": 5}}
     assert upgrade_fingerprint(dmc) == dmc
+    # An arm checkpoint that names no layout was trained on the tasks' routing of its day, now
+    # called ventral_from_base: today's default refuses it by name, that layout resumes it.
+    unnamed = {k: v for k, v in run.fingerprint().items() if k != "layout"}
+    assert run.fingerprint()["layout"] == "ventral_slips"
+    assert upgrade_fingerprint(unnamed)["layout"] == "ventral_from_base"
+    path = str(tmp_path / "unnamed.pkl")
+    checkpoint.save(path, checkpoint.load(run.checkpoint_path), unnamed)
+    with pytest.raises(ValueError, match="layout: checkpoint has 'ventral_from_base', this run has 'ventral_slips'"):
+        CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "g"), task_kwargs=uniform).restore(path)
+    CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "h"), task_kwargs=uniform,
+                  layout="ventral_from_base").restore(path)
 
 
 def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
@@ -260,9 +271,11 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     assert SACConfig(target_entropy=-3.0).resolved_target_entropy(9) == -3.0  # an explicit value wins
     assert [config.her_ratio_in_lesson(t) for t in ("lesson1", "lesson2", "lesson3", "lesson4")] == [0.5, 0.0, 0.0, 0.0]
     assert not config.her_level_goals and not SACConfig.paper_sac().her_level_goals
-    assert training.resolve_layout(None, arm) == "antagonist_pairs"
-    assert training.resolve_layout("paper", arm) is None  # the tasks' own layout, as older checkpoints name it
-    assert training.resolve_layout("ventral_slips", arm) == "ventral_slips" and training.resolve_layout(None, dmc) is None
+    assert training.resolve_layout(None, arm) == "ventral_slips" == arm.layout  # the tasks' own, by name
+    assert training.resolve_layout("antagonist_pairs", arm) == "antagonist_pairs"
+    assert training.resolve_layout(None, dmc) is None and dmc.layout is None
+    with pytest.raises(ValueError, match="'paper' is now called 'ventral_from_base'"):
+        Domain("robostrich", "paper")
     recipe = {"weights": {"position_precision": 1.0, "attitude_precision": 0.5}, "target_sampling": "failures",
               "fixed_stored_starts": 0.25}
     assert training.resolve_task_kwargs({}, arm) == recipe

@@ -154,7 +154,7 @@ def test_checkpoints_that_cannot_start_the_run_are_refused(source, tmp_path):
         transfer.check_source(path, A1_PLAN, dataclasses.replace(TINY, hidden_sizes=(32, 32)))
     with pytest.raises(transfer.TransferError, match="critic_layer_norm"):
         transfer.check_source(path, A1_PLAN, dataclasses.replace(TINY, critic_layer_norm=False))
-    with pytest.raises(transfer.TransferError, match=r"tendon layout 'paper', this run uses 'antagonist_pairs' \(pass --layout paper\)"):
+    with pytest.raises(transfer.TransferError, match=r"tendon layout 'ventral_slips', this run uses 'antagonist_pairs' \(pass --layout ventral_slips\)"):
         transfer.check_source(path, A1_PLAN, TINY, layout="antagonist_pairs")
     with pytest.raises(FileNotFoundError, match="no checkpoint file"):
         transfer.check_source(str(tmp_path / "missing.pkl"), A1_PLAN, TINY)
@@ -178,7 +178,7 @@ def test_train_from_a_frame_checkpoint_end_to_end(source, tmp_path):
     bad = start("robostrich-train", "--domain", "robostrich_a1", "--init-from", tmp_path / "nope.pkl",
                 "--out", tmp_path / "bad", *TINY_ARGS)
     result = call("robostrich-train", "--domain", "robostrich_a1", "--init-from", path, "--steps", "600",
-                  "--workers", "1", "--out", out, "--layout", "paper", *TINY_ARGS)  # the source's layout
+                  "--workers", "1", "--out", out, *TINY_ARGS)  # the source's layout, the default
     assert_succeeded(result)
     assert_user_error(finish(bad), "--init-from: no checkpoint file", "nope.pkl")
     assert not (tmp_path / "bad").exists()
@@ -189,7 +189,7 @@ def test_train_from_a_frame_checkpoint_end_to_end(source, tmp_path):
     assert json.loads((out / "config.json").read_text())["init_from"]["sha256"] == digest
     # A resume must come from the same checkpoint; another one is refused before anything is touched.
     other = call("robostrich-train", "--domain", "robostrich_a1", "--init-from", out / "baseline" / "checkpoint.pkl",
-                 "--steps", "600", "--out", out, "--resume", "--layout", "paper", *TINY_ARGS)
+                 "--steps", "600", "--out", out, "--resume", *TINY_ARGS)
     assert_user_error(other, "did not start from --init-from")
 
 

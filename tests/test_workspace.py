@@ -22,7 +22,7 @@ def kinematic(physics):
 
 @pytest.fixture(scope="module")
 def actuated(physics):
-    return workspace.actuated_samples(16, seed=3, physics=physics)
+    return workspace.actuated_samples(32, seed=3, physics=physics)  # 15 come to rest within an episode
 
 
 def test_head_stays_within_the_sum_of_link_lengths(kinematic, physics):
@@ -112,9 +112,9 @@ def test_actuated_workspace_reaches_less_than_the_kinematic_one(actuated, kinema
 
 
 def test_level_seeking_finds_inputs_that_hold_the_head_level(physics):
-    samples = workspace.actuated_samples(6, seed=2, physics=physics, seek_level_time=2.5)
+    samples = workspace.actuated_samples(12, seed=2, physics=physics, seek_level_time=2.5)
     level = samples.level()
-    assert level.sum() >= 2  # measured 42 % of draws (3.5 % without seeking)
+    assert level.sum() >= 3  # measured 5 of these 12 draws, about half of 40 (a few % without seeking)
     for control, head in zip(samples.control[level], samples.head_position[level]):
         assert workspace.settle(physics, control)  # the stored inputs alone, from reset
         np.testing.assert_allclose(physics.head_position()[[0, 2]], head, atol=1e-9)

@@ -40,6 +40,9 @@ ARM_MODEL_NAME = "arm"
 HEAD_SITE = "head"
 HEAD_VELOCITY_SENSOR = "head_velocity"
 COLLISION_TYPE = 2  # contype of arm geoms; obstacles the arm may touch set this bit in conaffinity.
+# The arm's own bit: its links collide with each other (as vertebrae do), and with nothing
+# else that does not set COLLISION_TYPE in its conaffinity.
+SELF_COLLISION_TYPE = 4
 
 
 @dataclasses.dataclass(frozen=True)
@@ -224,7 +227,13 @@ class TendonLayout:
 
     @classmethod
     def robostrich(cls, spec: ArmSpec | None = None) -> "TendonLayout":
-        """The paper's layout: 1 dorsal tendon to the head + 8 ventral tendons."""
+        """The default layout, our reconstruction of the paper's Fig. 1B: 1 dorsal tendon
+        to the head + 8 ventral slips (:meth:`ventral_slips`; docs/layouts.md says why)."""
+        return cls.ventral_slips(spec)
+
+    @classmethod
+    def ventral_from_base(cls, spec: ArmSpec | None = None) -> "TendonLayout":
+        """1 dorsal tendon to the head + 8 ventral tendons, each anchored on the base."""
         spec = spec or ArmSpec.from_table1()
         dorsal = TendonSpec.spanning("dorsal", "dorsal", spec.head_name, spec)
         ventral = [TendonSpec.spanning(f"ventral_{link}", "ventral", link, spec)
@@ -305,7 +314,8 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
     model.option.timestep = PHYSICS_TIMESTEP
     link_default = model.default.add("default", dclass="link")
     link_default.geom.set_attributes(type="capsule", size=[spec.link_radius],
-                                     contype=COLLISION_TYPE, conaffinity=0,
+                                     contype=COLLISION_TYPE | SELF_COLLISION_TYPE,
+                                     conaffinity=SELF_COLLISION_TYPE, condim=1,
                                      rgba=[0.85, 0.8, 0.7, 1])
     link_default.joint.set_attributes(type="hinge", axis=[0, 1, 0], limited=True,
                                       stiffness=spec.joint_stiffness, damping=spec.joint_damping,
@@ -336,7 +346,7 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
         length = lengths.get(name, spec.head_length)
         if name == spec.head_name:
             body.add("geom", name=f"{name}_geom", fromto=[0, 0, 0, 0, 0, length],
-                     size=[spec.link_radius * 1.6], mass=masses[name], rgba=[0.9, 0.6, 0.3, 1])
+                     size=[_link_geom_radius(spec, name)], mass=masses[name], rgba=[0.9, 0.6, 0.3, 1])
             head_site = body.add("site", name=HEAD_SITE,
                                  pos=[0, 0, spec.head_site_fraction * length],
                                  size=[0.004], rgba=[1, 0, 0, 1])
@@ -361,8 +371,35 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
         for link in tendon.links:
             element.add("site", site=hole_site_name(link, tendon.side))
 
+    _exclude_touching_links(model, spec)
     _add_tendon_servos(model, spec, layout)
     return model
+
+
+def _link_geom_radius(spec: ArmSpec, name: str) -> float:
+    return spec.link_radius * (1.6 if name == spec.head_name else 1.0)
+
+
+def touching_link_pairs(spec: ArmSpec) -> list[tuple[str, str]]:
+    """Pairs of links two or more joints apart whose capsules already touch in the
+    straight pose (the links between them are shorter than the two radii): they are
+    neighbours in all but name, so they do not collide.  MuJoCo leaves out the
+    parent-child pairs itself; every other pair of links collides."""
+    caudal_to_cranial = list(reversed(spec.joint_names))
+    lengths = dict(zip(spec.joint_names[1:], spec.link_lengths))
+    pairs = []
+    for i, first in enumerate(caudal_to_cranial):
+        for second in caudal_to_cranial[i + 2:]:
+            between = caudal_to_cranial[i + 1:caudal_to_cranial.index(second)]
+            gap = sum(lengths[name] for name in between)
+            if gap <= _link_geom_radius(spec, first) + _link_geom_radius(spec, second):
+                pairs.append((first, second))
+    return pairs
+
+
+def _exclude_touching_links(model: mjcf.RootElement, spec: ArmSpec) -> None:
+    for first, second in touching_link_pairs(spec):
+        model.contact.add("exclude", name=f"{first}_{second}", body1=first, body2=second)
 
 
 def _add_tendon_servos(model: mjcf.RootElement, spec: ArmSpec, layout: TendonLayout) -> None:

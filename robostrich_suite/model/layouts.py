@@ -51,16 +51,26 @@ class LayoutFileError(ValueError):
     """A layout file that cannot be read as a layout; the message names file and item."""
 
 
-def paper(spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
-    """The paper's routing (the tasks' default): a dorsal tendon to the head and 8
-    ventral tendons from the base, inserting at every second vertebra C16 ... C2."""
-    return arm_lib.TendonLayout.robostrich(spec)
+def ventral_from_base(spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
+    """A dorsal tendon to the head and 8 ventral tendons anchored on the base, inserting at
+    every second vertebra C16 ... C2 (the project's first guess at the paper's Fig. 1B)."""
+    return arm_lib.TendonLayout.ventral_from_base(spec)
 
 
 def ventral_slips(spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
-    """The paper's insertions, each ventral tendon tied 4 joints caudal of it (the
-    ostrich's overlapping longus colli slips; the movement tests' default)."""
+    """The paper's Fig. 1B as we reconstruct it (the default): the dorsal tendon to the
+    head and 8 ventral slips at the same insertions, each tied 4 joints caudal of its
+    insertion, like the ostrich's overlapping longus colli slips."""
     return arm_lib.TendonLayout.ventral_slips(spec)
+
+
+def _slips_of_span(span: int):
+    def factory(spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
+        return arm_lib.TendonLayout.ventral_slips(spec, span=span)
+    factory.__name__ = f"ventral_slips_{span}"
+    factory.__doc__ = (f"As ventral_slips, each slip tied {span} joints caudal of its insertion "
+                       "(another candidate reconstruction of Fig. 1B).")
+    return factory
 
 
 def second_dorsal(spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
@@ -102,13 +112,37 @@ class BuiltIn:
         return " ".join(self.factory.__doc__.split())
 
 
-BUILT_IN = {f.__name__: BuiltIn(f) for f in (paper, ventral_slips, second_dorsal, cranial_every,
+# Spans of the other candidate reconstructions of Fig. 1B (docs/layouts.md).
+CANDIDATE_SLIP_SPANS = (2, 3, 6)
+BUILT_IN = {f.__name__: BuiltIn(f) for f in (ventral_slips, *map(_slips_of_span, CANDIDATE_SLIP_SPANS),
+                                             ventral_from_base, second_dorsal, cranial_every,
                                              antagonist_pairs)}
-DEFAULT = "paper"  # the tasks' layout
+DEFAULT = "ventral_slips"  # the tasks' layout: arm_lib.TendonLayout.robostrich
+# Names a layout had before, with its name now: a checkpoint or command line naming one gets told.
+RENAMED = {"paper": "ventral_from_base"}
+
+
+def follows_fig1b(layout: arm_lib.TendonLayout, spec: arm_lib.ArmSpec | None = None) -> bool:
+    """True for a candidate reconstruction of the paper's Fig. 1B: one dorsal tendon to the head
+    and eight ventral tendons at the paper's insertion levels (C16, C14, ..., C2), however
+    they are routed caudally."""
+    spec = spec or arm_lib.ArmSpec.from_table1()
+    dorsal = [t for t in layout.tendons if t.side == "dorsal"]
+    ventral = sorted(t.insertion for t in layout.tendons if t.side == "ventral")
+    return (len(dorsal) == 1 and dorsal[0].insertion == spec.head_name
+            and ventral == sorted(arm_lib.TendonLayout.ROBOSTRICH_VENTRAL_INSERTIONS))
+
+
+def fig1b_candidates() -> list[str]:
+    """The built-in layouts that :func:`follows_fig1b`, the tasks' default first."""
+    return [name for name in BUILT_IN if follows_fig1b(build(name))]
 
 
 def check_built_in(name: str) -> None:
     """ValueError naming the built-in layouts if ``name`` is not one of them."""
+    if name in RENAMED:
+        raise ValueError(f"layout {name!r} is now called {RENAMED[name]!r} (the default, "
+                         f"{DEFAULT!r}, is the reconstruction of the paper's routing)")
     if name not in BUILT_IN:
         raise ValueError(f"unknown layout {name!r}; built-in layouts are {list(BUILT_IN)}")
 

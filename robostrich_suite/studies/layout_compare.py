@@ -101,14 +101,14 @@ def movement_ratio(case: Case) -> dict:
     layout = movement_layout(case.layout, case.spec)
     if layout is None:
         return {"rolling_range_deg": None, "lever_range_deg": None, "rolling_lever_ratio": None,
-                "head_travel_m": None}
+                "head_travel_mm": None}
     rolling = movement.run(_LayoutMovement(tendon_layout=layout), case.spec)
     lever = _LayoutMovement(pattern="lever", tendon_layout=layout)
     amplitude = movement.match_lever_amplitude(lever, rolling.head_travel(), case.spec)
     lever = movement.run(dataclasses.replace(lever, lever_amplitude=amplitude), case.spec)
     ratio = rolling.attitude_range() / max(lever.attitude_range(), 1e-9)
     return {"rolling_range_deg": rolling.attitude_range(), "lever_range_deg": lever.attitude_range(),
-            "rolling_lever_ratio": ratio, "head_travel_m": rolling.head_travel()}
+            "rolling_lever_ratio": ratio, "head_travel_mm": 1000 * rolling.head_travel()}
 
 
 def heldout_success(case: Case, heldout: np.ndarray, make_actor, seed: int = 10_000) -> dict:
@@ -278,6 +278,7 @@ COLUMNS = (  # (row key, table heading, format)
     ("coverage", "coverage", "{:.0%}"),
     ("level_poses", "level poses held", "{}"),
     ("distinct_targets", "distinct level targets", "{}"),
+    ("head_travel_mm", "head travel (mm)", "{:.0f}"),
     ("rolling_range_deg", "rolling range (deg)", "{:.1f}"),
     ("lever_range_deg", "lever range (deg)", "{:.1f}"),
     ("rolling_lever_ratio", "rolling / lever", "{:.2f}"),
@@ -335,6 +336,11 @@ def main(argv=None) -> dict:
     parser.add_argument("--layouts", nargs="*", default=list(layouts_lib.BUILT_IN),
                         choices=list(layouts_lib.BUILT_IN), metavar="NAME",
                         help="built-in layouts to compare (default: all of them)")
+    parser.add_argument("--candidates", action="store_true",
+                        help="the fidelity check: compare the built-in candidate reconstructions of the "
+                             "paper's Fig. 1B (one dorsal tendon to the head, eight ventral tendons at "
+                             "C16, C14, ..., C2: " + ", ".join(layouts_lib.fig1b_candidates())
+                             + ") instead of --layouts")
     parser.add_argument("--layout-file", nargs="+", default=[], type=pathlib.Path, metavar="FILE",
                         help="also compare layouts from JSON/TOML files (see "
                              "robostrich_suite/model/layouts.py for the format)")
@@ -362,6 +368,8 @@ def main(argv=None) -> dict:
                         help="processes, one case each (default: %(default)s)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
+    if args.candidates:
+        args.layouts = layouts_lib.fig1b_candidates()
     if not args.layouts and not args.layout_file:
         parser.error("nothing to compare: give --layouts and/or --layout-file")
 

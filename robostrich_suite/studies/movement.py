@@ -4,9 +4,10 @@ Scripted tendon inputs on the arm on its immobile frame.  The dorsal tendon is h
 while the ventral tendons are ramped: **rolling** contracts them one after another,
 caudal to cranial, so the bend travels along the neck; **lever** contracts them
 together, to the amplitude at which the head travels as far (``match_lever_amplitude``).
-The defaults (:class:`MovementConfig`: ventral slips, dorsal input held) are the setting
-in which the paper's difference shows (rolling keeps the attitude range at 0.42 of the
-lever's); on the tasks' arm (``PAPER_LAYOUT``, ``--paper-layout``) it does not.  The
+The defaults (:class:`MovementConfig`: the tasks' arm, whose ventral tendons are slips,
+dorsal input held) are the setting in which the paper's difference shows (rolling keeps
+the attitude smaller than the lever); on the routing with every ventral tendon from the
+base (``FROM_BASE``, ``--from-base``) it does not.  The
 measurements, the settings tried and why are in ``docs/movement.md``.
 """
 from __future__ import annotations
@@ -37,9 +38,9 @@ class MovementConfig:
     """Scripted inputs of one movement test (contractions in metres).
 
     The defaults are the setting in which the paper's difference shows (see
-    docs/movement.md): ventral slips four joints long, the dorsal servo's input
-    held, rolling as a travelling wave.  ``PAPER_LAYOUT`` is the same test on the
-    tasks' arm, whose ventral tendons all run from the base.
+    docs/movement.md): ventral slips four joints long (the tasks' arm), the dorsal
+    servo's input held, rolling as a travelling wave.  ``FROM_BASE`` is the same test
+    on the ``ventral_from_base`` routing, whose ventral tendons all run from the base.
     """
     pattern: str = "rolling"
     dorsal: float = -0.02  # dorsal contraction held throughout (negative = paid out)
@@ -65,7 +66,7 @@ class MovementConfig:
 
     def layout(self, spec: arm_lib.ArmSpec) -> arm_lib.TendonLayout:
         if self.ventral_span is None:
-            return arm_lib.TendonLayout.robostrich(spec)
+            return arm_lib.TendonLayout.ventral_from_base(spec)
         return arm_lib.TendonLayout.ventral_slips(spec, self.ventral_span)
 
     def ventral_amplitude(self) -> float:
@@ -74,9 +75,9 @@ class MovementConfig:
         return self.amplitude
 
 
-# The tasks' arm (every ventral tendon from the base), dorsal length held as in the
+# Every ventral tendon from the base (ventral_from_base), dorsal length held as in the
 # paper, rolling as successive contractions: both patterns end in the same pose.
-PAPER_LAYOUT = dict(ventral_span=None, dorsal_hold="length", release=False, ramp_time=1.0)
+FROM_BASE = dict(ventral_span=None, dorsal_hold="length", release=False, ramp_time=1.0)
 
 
 def hold_dorsal_length(dorsal_input: float, target: float, contraction: float, dt: float,
@@ -370,13 +371,13 @@ def main(argv=None) -> dict:
                     "patterns of the ventral tendons while the dorsal tendon is held. Writes "
                     "{pattern}.png (tendon inputs, head attitude, stick figures) and "
                     "{pattern}.rrd (open with `rerun FILE`). The defaults show the paper's "
-                    "difference; --paper-layout runs the same test on the tasks' arm, where "
-                    "it does not appear (see docs/movement.md).")
+                    "difference; --from-base runs the same test on the routing with every "
+                    "ventral tendon from the base, where it does not appear (see docs/movement.md).")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/movement"),
                         help="output directory (default: %(default)s)")
     parser.add_argument("--patterns", nargs="+", choices=PATTERNS, default=list(PATTERNS))
-    parser.add_argument("--paper-layout", action="store_true",
-                        help="the tasks' arm (every ventral tendon from the base), dorsal length "
+    parser.add_argument("--from-base", action="store_true",
+                        help="the ventral_from_base routing (every ventral tendon from the base), dorsal length "
                              "held, successive contractions; overrides --ventral-span, "
                              "--dorsal-hold, --ramp-time and --no-release")
     defaults = MovementConfig()
@@ -415,8 +416,8 @@ def main(argv=None) -> dict:
     setting = dict(ventral_span=args.ventral_span, dorsal=args.dorsal, amplitude=args.amplitude,
                    ramp_time=args.ramp_time, dorsal_hold=args.dorsal_hold,
                    release=not args.no_release)
-    if args.paper_layout:
-        setting.update(PAPER_LAYOUT)
+    if args.from_base:
+        setting.update(FROM_BASE)
     base = MovementConfig(**setting)
     ventral = sum(t.side == "ventral" for t in base.layout(spec).tendons)
     for pattern in args.patterns:  # every bad setting before anything is written

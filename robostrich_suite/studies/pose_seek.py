@@ -24,14 +24,13 @@ from robostrich_suite.model import arm as arm_lib
 from robostrich_suite.model import scenes
 from robostrich_suite.studies import workspace
 from robostrich_suite.tasks import conventions
-from robostrich_suite.tasks.lessons import LESSON_TIME_LIMIT
 
 SEEK_TIME = 8.0  # s of input adjustment per target
 SEEK_GAIN = 0.003  # fraction of the wanted tendon-length change applied per update
 UPDATE_EVERY = 4  # physics steps per update: the environments' control step
 ATTITUDE_SCALE = 0.1  # m per rad: how a degree of attitude error weighs against position
 DAMPING = 1e-4  # of the least-squares joint step
-HOLD_TIME = LESSON_TIME_LIMIT  # s a candidate is held from the fixed start: one episode
+HOLD_TIME = workspace.SETTLE_TIME  # s a candidate is held from the fixed start: one episode
 
 
 def contraction_at(physics, joint_angles: np.ndarray, spec: arm_lib.ArmSpec) -> np.ndarray:

@@ -2,10 +2,16 @@
 
 The tasks' targets are the level subset of the *actuated* workspace
 (:func:`workspace.actuated_samples`), each with the tendon inputs that hold it;
-:mod:`robostrich_suite.targets` loads the files written here.  Regenerate the shipped
-file after changing the default arm with::
+:mod:`robostrich_suite.targets` loads the files written here.  After a change to the
+arm that moves few poses (a contact, a limit), re-hold a file's stored inputs and keep
+the poses still held level, at their new positions::
 
-    robostrich-targets --samples 4000 --out robostrich_suite/data/level_head_poses.npz
+    robostrich-targets --recheck --out robostrich_suite/data/level_head_poses_antagonist_pairs.npz --layout antagonist_pairs
+
+The shipped files are random draws plus a sought pose per blue-region sample (docs/layouts.md
+names each file's command)::
+
+    robostrich-targets --samples 2000 --blue-samples 600000 --layout ventral_slips --out robostrich_suite/data/level_head_poses.npz
 """
 from __future__ import annotations
 
@@ -17,28 +23,39 @@ import numpy as np
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import targets
 from robostrich_suite.model import fingerprint as fingerprint_lib
-from robostrich_suite.studies import workspace
+from robostrich_suite.studies import pose_seek, workspace
 
 SEEK_LEVEL_TIME = 2.5  # s of dorsal-input tuning per draw before it is held
 
 
 def generate(num_samples: int, seed: int = 0, path: pathlib.Path = targets.DATA_PATH,
              workers: int = 2, append: bool = False,
-             seek_level_time: float = SEEK_LEVEL_TIME, spec=None, layout=None) -> int:
+             seek_level_time: float = SEEK_LEVEL_TIME, spec=None, layout=None,
+             blue_samples: int = 0) -> int:
     """Sample the actuated workspace and save its level subset; returns its size.
 
     ``seek_level_time`` > 0 tunes each draw's dorsal input towards a level head
     before holding it (:func:`workspace.seek_level`): many more
-    level poses per CPU second.  With ``append`` the new poses are added to those
-    already in ``path`` (which must come from the same arm); use another seed.
-    ``spec`` and ``layout`` (an ``ArmSpec`` and ``TendonLayout``) make targets for
-    another arm; write them to another ``path`` and pass
+    level poses per CPU second.  ``blue_samples`` > 0 also seeks one pose per level head
+    among that many kinematic samples (the blue region of Fig. 6;
+    :func:`pose_seek.seek_samples`), which fills the region random inputs rarely reach.
+    Every pose is held from the fixed start for one episode.  With ``append`` the new
+    poses are added to those already in ``path`` (which must come from the same arm);
+    use another seed.  ``spec`` and ``layout`` (an ``ArmSpec`` and ``TendonLayout``) make
+    targets for another arm; write them to another ``path`` and pass
     ``training_targets(path)`` as the tasks' ``target_pool``.
     """
-    samples = workspace.actuated_samples_parallel(num_samples, seed=seed, workers=workers,
-                                                  progress=True,
-                                                  seek_level_time=seek_level_time,
-                                                  spec=spec, layout=layout)
+    parts = []
+    if num_samples > 0:
+        parts.append(workspace.actuated_samples_parallel(num_samples, seed=seed, workers=workers,
+                                                         progress=True,
+                                                         seek_level_time=seek_level_time,
+                                                         spec=spec, layout=layout))
+    if blue_samples > 0:
+        parts.append(seek_blue_region(blue_samples, seed, workers, spec, layout))
+    if not parts:
+        raise ValueError("nothing to draw: give samples and/or blue samples")
+    samples = workspace.ActuatedSamples.concatenate(parts)
     level = samples.level()
     fingerprint = fingerprint_lib.model_fingerprint(spec, layout)
     new = dict(head_position=samples.head_position[level],
@@ -49,6 +66,61 @@ def generate(num_samples: int, seed: int = 0, path: pathlib.Path = targets.DATA_
                 raise ValueError(f"{path} was made with another arm; regenerate without --append")
             new = {key: np.concatenate([old[key], value]) for key, value in new.items()}
     return save_level_poses(path, new, fingerprint)
+
+
+def _seek_chunk(args) -> workspace.ActuatedSamples:
+    positions, angles, spec, layout = args
+    return pose_seek.seek_samples(positions, angles, spec, layout)
+
+
+def seek_blue_region(kinematic_samples: int, seed: int = 0, workers: int = 2, spec=None,
+                     layout=None) -> workspace.ActuatedSamples:
+    """One sought pose (held from the fixed start) per level head among ``kinematic_samples``
+    kinematic samples, split over ``workers`` processes."""
+    from robostrich_suite.studies import coverage
+    region = coverage.BlueRegion.from_samples(workspace.kinematic_samples(kinematic_samples, seed, spec))
+    chunks = [(p, a, spec, layout) for p, a in zip(np.array_split(region.head_position, workers),
+                                                  np.array_split(region.joint_angles, workers)) if len(p)]
+    if not chunks:
+        raise ValueError(f"no level head among {kinematic_samples} kinematic samples; draw more")
+    if len(chunks) == 1:
+        return _seek_chunk(chunks[0])
+    from concurrent.futures import ProcessPoolExecutor
+    with ProcessPoolExecutor(len(chunks)) as pool:
+        return workspace.ActuatedSamples.concatenate(list(pool.map(_seek_chunk, chunks)))
+
+
+def recheck(path: pathlib.Path, spec=None, layout=None, settle_time: float = pose_seek.HOLD_TIME,
+            progress: bool = False) -> tuple[int, int]:
+    """Hold every stored pose's inputs in ``path`` from reset on today's arm (``spec``,
+    ``layout``) and rewrite the file with the poses that still come to rest level, at
+    the positions they reach now; returns ``(kept, stored)``."""
+    from robostrich_suite import physics as physics_lib
+    from robostrich_suite.model import scenes
+    poses = targets.level_head_poses(path)
+    physics = scenes.frame_physics(spec, layout)
+    if poses["control"].shape[1] != physics.model.nu:
+        raise ValueError(f"{path} holds inputs for {poses['control'].shape[1]} tendons, the arm has "
+                         f"{physics.model.nu}: pass the layout it was made with")
+    kept = dict(head_position=[], head_attitude=[], control=[])
+    iterator = poses["control"]
+    if progress:
+        from tqdm import tqdm
+        iterator = tqdm(iterator, desc="recheck", unit="pose", mininterval=1.0)
+    for control in iterator:
+        if not workspace.settle(physics, control, settle_time):
+            continue
+        attitude = physics.head_attitude()
+        if abs(physics_lib.attitude_error_deg(attitude, workspace.LEVEL_ATTITUDE_DEG)) > workspace.LEVEL_TOLERANCE_DEG:
+            continue
+        kept["head_position"].append(physics.head_position()[[0, 2]])
+        kept["head_attitude"].append(attitude)
+        kept["control"].append(np.array(control))
+    stored = len(poses["control"])
+    if not kept["control"]:
+        raise ValueError(f"no pose of {path} is held level by this arm; make a new file")
+    save_level_poses(path, kept, fingerprint_lib.model_fingerprint(spec, layout))
+    return len(kept["control"]), stored
 
 
 def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str) -> int:
@@ -65,7 +137,11 @@ def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str) -> int:
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(prog="robostrich-targets", description=__doc__.split("\n")[0])
-    parser.add_argument("--samples", type=int, default=4000)
+    parser.add_argument("--samples", type=cli_lib.whole_number(0), default=4000,
+                        help="random held inputs (default: %(default)s)")
+    parser.add_argument("--blue-samples", type=cli_lib.whole_number(0), default=0,
+                        help="kinematic samples whose level heads (the blue region) each get a sought "
+                             "pose (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=pathlib.Path, required=True,
                         help="target file to write (the shipped one: robostrich_suite/data/level_head_poses.npz)")
@@ -73,9 +149,26 @@ def main(argv=None) -> None:
                         help="seconds of dorsal tuning towards a level head per draw (0: off)")
     parser.add_argument("--append", action="store_true",
                         help="add to the poses already in --out (use a new --seed)")
+    parser.add_argument("--recheck", action="store_true",
+                        help="draw nothing: re-hold the stored inputs of --out on today's arm and keep "
+                             "the poses still held level, at their new positions")
+    parser.add_argument("--layout", default=None, metavar="NAME",
+                        help="built-in tendon layout of the arm (default: the tasks' own)")
+    parser.add_argument("--workers", type=cli_lib.whole_number(1), default=2,
+                        help="processes drawing poses (default: %(default)s)")
     args = parser.parse_args(argv)
-    count = generate(args.samples, args.seed, args.out, append=args.append,
-                     seek_level_time=args.seek_level_time)
+    layout = None
+    if args.layout is not None:
+        from robostrich_suite.model import layouts
+        layout = layouts.build(args.layout)
+    if args.recheck:
+        if not args.out.exists():
+            raise FileNotFoundError(f"--recheck: no target file at {args.out}")
+        kept, stored = recheck(args.out, layout=layout, progress=True)
+        print(f"kept {kept} of {stored} level-head poses in {args.out}")
+        return
+    count = generate(args.samples, args.seed, args.out, workers=args.workers, append=args.append,
+                     seek_level_time=args.seek_level_time, layout=layout, blue_samples=args.blue_samples)
     print(f"wrote {count} level-head poses to {args.out}")
 
 

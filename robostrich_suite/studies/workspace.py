@@ -28,6 +28,11 @@ from robostrich_suite.model import arm as arm_lib
 from robostrich_suite.model import fingerprint as fingerprint_lib
 from robostrich_suite.model import scenes
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
+from robostrich_suite.tasks.lessons import LESSON_TIME_LIMIT
+
+# s an input is held from reset before the pose counts: one lesson episode, the time the lookup
+# baseline and a policy have (the slips' neck swings longer than 1.5 s after some inputs).
+SETTLE_TIME = LESSON_TIME_LIMIT
 # Joint limits are soft constraints (arm.ArmSpec.limit_solref): a settled pose may
 # sit slightly past Table 1.  Measured over 1200 random tendon inputs: at most 0.8 deg.
 LIMIT_TOLERANCE_DEG = 1.0
@@ -140,7 +145,7 @@ class ActuatedSamples:
                      else np.concatenate([getattr(p, f) for p in parts]) for f in fields))
 
 
-def settle(physics: scenes.FramePhysics, control: np.ndarray, settle_time: float = 1.5,
+def settle(physics: scenes.FramePhysics, control: np.ndarray, settle_time: float = SETTLE_TIME,
            speed_tolerance: float = 0.05) -> bool:
     """Reset, hold ``control`` for ``settle_time`` seconds; True if the arm came to rest.
     A simulation that diverged never did, even where MuJoCo's reset left it still."""
@@ -175,7 +180,7 @@ def seek_level(physics: scenes.FramePhysics, control: np.ndarray, seek_time: flo
     return control
 
 
-def actuated_samples(num_samples: int, seed: int = 0, settle_time: float = 1.5,
+def actuated_samples(num_samples: int, seed: int = 0, settle_time: float = SETTLE_TIME,
                      physics: scenes.FramePhysics | None = None, progress: bool = False,
                      seek_level_time: float = 0.0, spec: arm_lib.ArmSpec | None = None,
                      layout: arm_lib.TendonLayout | None = None) -> ActuatedSamples:
@@ -214,7 +219,7 @@ def _actuated_chunk(args) -> ActuatedSamples:
                             seek_level_time=seek_level_time, spec=spec, layout=layout)
 
 
-def actuated_samples_parallel(num_samples: int, seed: int = 0, settle_time: float = 1.5,
+def actuated_samples_parallel(num_samples: int, seed: int = 0, settle_time: float = SETTLE_TIME,
                               workers: int = 2, progress: bool = False,
                               seek_level_time: float = 0.0,
                               spec: arm_lib.ArmSpec | None = None,
@@ -271,7 +276,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--actuated-samples", type=cli_lib.whole_number(0), default=600,
                         help="actuated samples: random held tendon inputs, 0 to skip "
                              "(default: %(default)s)")
-    parser.add_argument("--settle-time", type=cli_lib.seconds(), default=1.5,
+    parser.add_argument("--settle-time", type=cli_lib.seconds(), default=SETTLE_TIME,
                         help="seconds each tendon input is held before the pose is recorded "
                              "(default: %(default)s)")
     parser.add_argument("--seek-level", type=cli_lib.seconds(allow_zero=True), default=0.0, metavar="SECONDS",
