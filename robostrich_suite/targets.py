@@ -8,9 +8,8 @@ comes with the tendon inputs that hold the head there, and a test re-simulates
 some of them.  Every fifth pose is held out for evaluation and never used in
 training.
 
-This module only loads them; regenerate them after changing the default arm with
-``robostrich-targets --out robostrich_suite/data/level_head_poses.npz``
-(:mod:`robostrich_suite.studies.target_generation`).
+This module only loads them; :mod:`robostrich_suite.studies.target_generation` makes them
+(its docstring has the shipped files' commands, and ``--recheck`` for a change to the arm).
 """
 from __future__ import annotations
 

@@ -8,6 +8,7 @@ import robostrich_suite
 from robostrich_suite import physics as physics_lib
 from robostrich_suite import targets
 from robostrich_suite.model import arm
+from robostrich_suite.model import layouts as layouts_lib
 from robostrich_suite.model import fingerprint as fingerprint_lib
 from robostrich_suite.model import scenes
 from robostrich_suite.studies import pose_seek, target_generation, workspace
@@ -89,3 +90,27 @@ def test_running_the_module_prints_no_runpy_warning():
     assert result.returncode == 0, result.stderr
     assert "RuntimeWarning" not in result.stderr and "Warning" not in result.stderr, result.stderr
     assert "--samples" in result.stdout
+
+
+def test_robostrich_targets_rechecks_a_file_and_names_bad_input(tmp_path):
+    """The installed command: --recheck rewrites a file with the poses still held; a missing file
+    or a renamed layout is one line on stderr and exit status 2."""
+    import os
+    import subprocess
+    from conftest import console_script
+    env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+    command = console_script("robostrich-targets")
+    path = tmp_path / "from_base.npz"
+    poses = targets.level_head_poses(layouts_lib.target_file("ventral_from_base"))
+    target_generation.save_level_poses(path, {k: poses[k][:5] for k in ("head_position", "head_attitude", "control")},
+                                       str(poses["fingerprint"]))
+    result = subprocess.run([command, "--recheck", "--out", path, "--layout", "ventral_from_base"],
+                            capture_output=True, text=True, env=env, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert "kept 5 of 5 level-head poses" in result.stdout
+    for args, message in ((["--recheck", "--out", tmp_path / "missing.npz"], "no target file at"),
+                          (["--recheck", "--out", path, "--layout", "paper"], "'paper' is now called 'ventral_from_base'")):
+        result = subprocess.run([command, *map(str, args)], capture_output=True, text=True, env=env, timeout=300)
+        lines = result.stderr.strip().splitlines()
+        assert result.returncode == 2 and len(lines) == 1 and message in lines[0], result.stderr
+        assert lines[0].startswith("robostrich-targets: error: ")

@@ -1,4 +1,7 @@
-"""``robostrich-layouts``: tendon layouts (and passive joint stiffnesses) side by side (issue 13).
+"""``robostrich-layouts``: tendon layouts (and passive joint stiffnesses) side by side.
+
+With ``--candidates`` it is the fidelity check of the reconstructions of the paper's Fig. 1B
+(:func:`layouts.fig1b_candidates`): the paper's own tests of its simulated arm, per candidate.
 
 Every case is one routing on the same Table 1 links.  Per case:
 
