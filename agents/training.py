@@ -65,7 +65,7 @@ def default_task_kwargs(domain: Domain) -> dict:
 
 def resolve_layout(layout: Optional[str], domain: Domain) -> Optional[str]:
     """The tendon layout a run trains: the one asked for, else the main job's on an arm domain."""
-    return layout if layout is not None or not domain.is_arm else DEFAULT_ARM_LAYOUT if layout is not None or not domain.is_arm else DEFAULT_ARM_LAYOUT
+    return layout if layout is not None or not domain.is_arm else DEFAULT_ARM_LAYOUT
 
 
 def resolve_task_kwargs(task_kwargs: dict, domain: Domain) -> dict:

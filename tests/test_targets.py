@@ -67,6 +67,9 @@ def test_another_arm_gets_a_warning_and_its_own_targets(tmp_path):
     two = arm.TendonLayout(slips.tendons[:2])
     with pytest.raises(ValueError, match="inputs for 9 tendons, the arm has 2"):
         target_generation.recheck(path, layout=two)
+    with pytest.raises(ValueError, match=r"only \d+ of \d+ poses .* left as it was"):  # the default arm's routing
+        target_generation.recheck(path, layout=arm.TendonLayout.ventral_from_base())
+    np.testing.assert_allclose(targets.level_head_poses(path)["head_position"], before, atol=1e-9)
     pool = np.concatenate([targets.training_targets(path), targets.heldout_targets(path)])
     assert len(pool) >= 1
     with warnings.catch_warnings():

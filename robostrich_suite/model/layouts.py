@@ -3,7 +3,8 @@
 The paper's text does not give its routing (Fig. 1B): :data:`DEFAULT` is the reconstruction
 its own tests choose among the candidates that keep its tendons (:func:`fig1b_candidates`;
 docs/layouts.md).  It left "the comparison of various tendon configurations" open;
-``robostrich-layouts`` (:mod:`robostrich_suite.studies.layout_compare`) compares the ones here.  Every built-in uses the Table 1 links, at most
+``robostrich-layouts`` (:mod:`robostrich_suite.studies.layout_compare`) compares the ones
+here.  Every built-in uses the Table 1 links, at most
 :data:`MAX_TENDONS` tendons and the generator's servos (ranges from the joint
 limits, the same force limit), so only the routing differs.
 

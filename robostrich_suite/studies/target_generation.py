@@ -26,6 +26,7 @@ from robostrich_suite.model import fingerprint as fingerprint_lib
 from robostrich_suite.studies import pose_seek, workspace
 
 SEEK_LEVEL_TIME = 2.5  # s of dorsal-input tuning per draw before it is held
+RECHECK_MIN_KEPT = 0.5  # a recheck that would drop more poses than this leaves the file alone
 
 
 def generate(num_samples: int, seed: int = 0, path: pathlib.Path = targets.DATA_PATH,
@@ -94,7 +95,8 @@ def recheck(path: pathlib.Path, spec=None, layout=None, settle_time: float = pos
             progress: bool = False) -> tuple[int, int]:
     """Hold every stored pose's inputs in ``path`` from reset on today's arm (``spec``,
     ``layout``) and rewrite the file with the poses that still come to rest level, at
-    the positions they reach now; returns ``(kept, stored)``."""
+    the positions they reach now; returns ``(kept, stored)``.  Where fewer than half are
+    kept the file is most likely another arm's: ValueError, and the file stays."""
     from robostrich_suite import physics as physics_lib
     from robostrich_suite.model import scenes
     poses = targets.level_head_poses(path)
@@ -117,8 +119,9 @@ def recheck(path: pathlib.Path, spec=None, layout=None, settle_time: float = pos
         kept["head_attitude"].append(attitude)
         kept["control"].append(np.array(control))
     stored = len(poses["control"])
-    if not kept["control"]:
-        raise ValueError(f"no pose of {path} is held level by this arm; make a new file")
+    if len(kept["control"]) < RECHECK_MIN_KEPT * stored:  # most likely another arm's file: keep it
+        raise ValueError(f"only {len(kept['control'])} of {stored} poses of {path} are held level by this arm "
+                         "(is the layout the one the file was made with?); the file is left as it was")
     save_level_poses(path, kept, fingerprint_lib.model_fingerprint(spec, layout))
     return len(kept["control"]), stored
 
