@@ -78,8 +78,7 @@ def named_layout(layout: Optional[str], plan) -> Optional[str]:
     the arm domains (None off them)."""
     if layout is not None or not _is_arm_plan(plan):
         return layout
-    from robostrich_suite.model import layouts
-    return layouts.DEFAULT
+    return as_domain(plan[-1].domain).layout  # the arm domain names its default
 
 
 def upgrade_fingerprint(fingerprint: dict) -> dict:

@@ -72,8 +72,8 @@ def test_links_do_not_pass_through_each_other():
     physics.reset()
     physics.forward()
     assert physics.data.ncon == 0  # the straight neck touches nothing
-    # Bend C9 and C6 far ventral, past their limits, so that C10's and C6's capsules cross:
-    # the contact pushes them apart (without it they would overlap by over a centimetre).
+    # Bend C9, C8 and C7 far ventral, past their limits, so that capsules two and more links
+    # apart cross: the contacts report them overlapping by over half a centimetre.
     with physics.reset_context():
         physics.named.data.qpos[["arm/c9", "arm/c8", "arm/c7"]] = 1.3
     geoms = {physics.model.id2name(int(g), "geom") for c in physics.data.contact[:physics.data.ncon]

@@ -389,9 +389,9 @@ def touching_link_pairs(spec: ArmSpec) -> list[tuple[str, str]]:
     lengths = dict(zip(spec.joint_names[1:], spec.link_lengths))
     pairs = []
     for i, first in enumerate(caudal_to_cranial):
-        for second in caudal_to_cranial[i + 2:]:
-            between = caudal_to_cranial[i + 1:caudal_to_cranial.index(second)]
-            gap = sum(lengths[name] for name in between)
+        for j in range(i + 2, len(caudal_to_cranial)):
+            second = caudal_to_cranial[j]
+            gap = sum(lengths[name] for name in caudal_to_cranial[i + 1:j])
             if gap <= _link_geom_radius(spec, first) + _link_geom_radius(spec, second):
                 pairs.append((first, second))
     return pairs

@@ -97,33 +97,31 @@ def recheck(path: pathlib.Path, spec=None, layout=None, settle_time: float = pos
     ``layout``) and rewrite the file with the poses that still come to rest level, at
     the positions they reach now; returns ``(kept, stored)``.  Where fewer than half are
     kept the file is most likely another arm's: ValueError, and the file stays."""
-    from robostrich_suite import physics as physics_lib
     from robostrich_suite.model import scenes
     poses = targets.level_head_poses(path)
     physics = scenes.frame_physics(spec, layout)
     if poses["control"].shape[1] != physics.model.nu:
         raise ValueError(f"{path} holds inputs for {poses['control'].shape[1]} tendons, the arm has "
                          f"{physics.model.nu}: pass the layout it was made with")
-    kept = dict(head_position=[], head_attitude=[], control=[])
-    iterator = poses["control"]
+    count = len(poses["control"])
+    held = workspace.ActuatedSamples(np.zeros((count, 2)), np.zeros(count), np.array(poses["control"]),
+                                     np.zeros(count, bool))
+    iterator = range(count)
     if progress:
         from tqdm import tqdm
         iterator = tqdm(iterator, desc="recheck", unit="pose", mininterval=1.0)
-    for control in iterator:
-        if not workspace.settle(physics, control, settle_time):
-            continue
-        attitude = physics.head_attitude()
-        if abs(physics_lib.attitude_error_deg(attitude, workspace.LEVEL_ATTITUDE_DEG)) > workspace.LEVEL_TOLERANCE_DEG:
-            continue
-        kept["head_position"].append(physics.head_position()[[0, 2]])
-        kept["head_attitude"].append(attitude)
-        kept["control"].append(np.array(control))
-    stored = len(poses["control"])
-    if len(kept["control"]) < RECHECK_MIN_KEPT * stored:  # most likely another arm's file: keep it
-        raise ValueError(f"only {len(kept['control'])} of {stored} poses of {path} are held level by this arm "
+    for i in iterator:
+        held.settled[i] = workspace.settle(physics, held.control[i], settle_time)
+        held.head_position[i] = physics.head_position()[[0, 2]]
+        held.head_attitude[i] = physics.head_attitude()
+    level = held.level()  # the level rule every target file is made with
+    kept = dict(head_position=held.head_position[level], head_attitude=held.head_attitude[level],
+                control=held.control[level])
+    if len(kept["control"]) < RECHECK_MIN_KEPT * count:  # most likely another arm's file: keep it
+        raise ValueError(f"only {len(kept['control'])} of {count} poses of {path} are held level by this arm "
                          "(is the layout the one the file was made with?); the file is left as it was")
     save_level_poses(path, kept, fingerprint_lib.model_fingerprint(spec, layout))
-    return len(kept["control"]), stored
+    return len(kept["control"]), count
 
 
 def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str) -> int:
