@@ -12,7 +12,7 @@ setup(
     description="Simulation and curriculum-SAC learning for the tendon-driven Robostrich arm.",
     python_requires=">=3.11",  # numpy 2.4, jax 0.10, scipy, matplotlib 3.11 and rerun-sdk 0.41 need 3.11
     packages=find_packages(include=["robostrich_suite", "robostrich_suite.*", "agents", "agents.*"]),
-    package_data={"robostrich_suite": ["data/*"]},
+    package_data={"robostrich_suite": ["data/*", "data/policies/*"]},
     install_requires=[
         "mujoco==3.17.0",
         "dm-control==1.0.50",
@@ -43,6 +43,7 @@ setup(
             "robostrich-gait = robostrich_suite.studies.gait_generation:cli",
             "robostrich-stabilize = agents.application_commands:stabilize_cli",
             "robostrich-gap = agents.application_commands:gap_cli",
+            "robostrich-play = agents.play:cli",
         ],
     },
 )

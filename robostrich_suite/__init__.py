@@ -56,6 +56,8 @@ except (ImportError, AttributeError, OSError) as _error:
         raise _renderer_error(_error) from _error
     raise
 
+from robostrich_suite.policies import load_policy  # noqa: E402,F401  (a shipped trained policy)
+
 _DOMAINS = collections.OrderedDict([("robostrich", robostrich), ("robostrich_a1", robostrich_a1)])
 
 ALL_TASKS = tuple((domain, task) for domain, module in _DOMAINS.items()

@@ -15,7 +15,12 @@ def model_fingerprint(spec: arm_lib.ArmSpec | None = None,
                       layout: arm_lib.TendonLayout | None = None) -> str:
     """Short hash of what decides where the arm comes to rest; a pose set made with
     another arm is stale.  Colours, names and sensors do not count."""
-    model = scenes.frame_physics(spec, layout).model
+    return compiled_fingerprint(scenes.frame_physics(spec, layout).model)
+
+
+def compiled_fingerprint(model) -> str:
+    """:func:`model_fingerprint` of a compiled MuJoCo model (an environment's
+    ``physics.model``): equal for the frame arm's domain and its frame physics."""
     digest = hashlib.sha256()
     for field in ("body_pos", "body_quat", "body_mass", "body_inertia", "jnt_range",
                   "jnt_stiffness", "jnt_solref", "jnt_solimp", "dof_damping", "dof_armature",

@@ -1,0 +1,143 @@
+"""Trained policies that ship with the package, run with numpy alone: no training, no JAX.
+
+A policy file (``.npz``) holds what acting needs and nothing else: the actor's layers
+(a ReLU MLP and the mean head; the action is ``tanh`` of the mean, mapped onto the
+action bounds), the observation layout it reads (keys and sizes, in order), the action
+bounds, the model fingerprint of the robot it was trained on, and how it was trained
+(command, seed, task, layout). :func:`load_policy` gives a callable: a dm_env timestep
+(or an observation dict) in, the environment's action out.
+
+    env = robostrich_suite.load("robostrich", "track")
+    policy = robostrich_suite.load_policy("robostrich", env)   # refuses another robot
+    timestep = env.reset()
+    while not timestep.last():
+        timestep = env.step(policy(timestep))
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import pathlib
+import zipfile
+
+import numpy as np
+
+from robostrich_suite.model import fingerprint as fingerprint_lib
+
+FORMAT_VERSION = 1
+POLICY_DIR = pathlib.Path(__file__).parent / "data" / "policies"
+# The shipped policies by name (a domain's default robot and task family).
+SHIPPED = {"robostrich": POLICY_DIR / "robostrich_curriculum.npz"}
+
+
+class PolicyMismatch(ValueError):
+    """A policy asked to act in an environment it was not trained for."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Policy:
+    """A deterministic tanh-Gaussian policy's mean, as trained (the moving average of its
+    parameters, which evaluations use)."""
+
+    hidden: tuple  # ((w, b), ...): ReLU layers
+    mean: tuple  # (w, b): the mean head, squashed by tanh into [-1, 1]
+    observation_layout: tuple  # ((key, size), ...) in the order the network reads them
+    action_low: np.ndarray
+    action_high: np.ndarray
+    fingerprint: str  # compiled_fingerprint of the environment's model it was trained in
+    info: dict  # how it was made: command, seed, domain, task, layout, run fingerprint
+
+    @property
+    def observation_size(self) -> int:
+        return int(sum(size for _, size in self.observation_layout))
+
+    def flatten(self, observation) -> np.ndarray:
+        """The observation dict as one vector, in the layout the network reads."""
+        try:
+            parts = [np.asarray(observation[key], np.float32).ravel() for key, _ in self.observation_layout]
+        except KeyError as error:
+            raise PolicyMismatch(f"the observation has no {error.args[0]!r}, which this policy reads") from None
+        flat = np.concatenate(parts)
+        if flat.size != self.observation_size:
+            raise PolicyMismatch(f"observation of size {flat.size}, this policy reads {self.observation_size}")
+        return flat
+
+    def select_action(self, flat_observation) -> np.ndarray:
+        """The environment action for a flattened observation (agents' actor interface)."""
+        h = np.asarray(flat_observation, np.float32)
+        for w, b in self.hidden:
+            h = np.maximum(h @ w + b, 0.0)
+        squashed = np.tanh(h @ self.mean[0] + self.mean[1]).astype(np.float64)
+        return self.action_low + 0.5 * (squashed + 1.0) * (self.action_high - self.action_low)
+
+    def __call__(self, timestep_or_observation) -> np.ndarray:
+        observation = getattr(timestep_or_observation, "observation", timestep_or_observation)
+        return self.select_action(self.flatten(observation))
+
+    def check(self, env) -> None:
+        """PolicyMismatch (one line) unless ``env`` is the robot this policy was trained on,
+        observes what it reads and takes the actions it gives."""
+        found = fingerprint_lib.compiled_fingerprint(env.physics.model)
+        if found != self.fingerprint:
+            raise PolicyMismatch(f"this policy was trained on model {self.fingerprint} "
+                                 f"({self.info.get('domain', '?')}, layout {self.info.get('layout', '?')}); "
+                                 f"the environment's model is {found}")
+        observed = {key: int(np.prod(spec.shape)) for key, spec in env.observation_spec().items()}
+        wrong = [key for key, size in self.observation_layout if observed.get(key) != size]
+        if wrong:  # a task may observe more (track: its target index) than the policy reads
+            raise PolicyMismatch(f"this policy reads {wrong}, which the environment does not observe "
+                                 f"with the same sizes ({observed})")
+        spec = env.action_spec()
+        if not (np.allclose(spec.minimum, self.action_low) and np.allclose(spec.maximum, self.action_high)):
+            raise PolicyMismatch("the environment's action bounds differ from the policy's")
+
+    def save(self, path) -> None:
+        """Write the policy file (beside it first, then renamed: never half-written)."""
+        path = pathlib.Path(path)
+        arrays = {f"hidden_{i}_{part}": a for i, layer in enumerate(self.hidden) for part, a in zip("wb", layer)}
+        arrays.update(mean_w=self.mean[0], mean_b=self.mean[1], action_low=self.action_low,
+                      action_high=self.action_high)
+        meta = {"format_version": FORMAT_VERSION, "fingerprint": self.fingerprint,
+                "observation_layout": [list(item) for item in self.observation_layout], "info": self.info}
+        tmp = path.with_name(path.name + ".tmp")
+        with open(tmp, "wb") as f:
+            np.savez_compressed(f, meta=np.array(json.dumps(meta)), **arrays)
+        tmp.replace(path)
+
+
+def read_policy(path) -> Policy:
+    """The policy in ``path``; ValueError naming the file if it is not a policy file of
+    the version this code reads."""
+    path = pathlib.Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            version = meta.get("format_version")
+            if version != FORMAT_VERSION:
+                raise ValueError(f"{path}: policy file format {version}, this code reads format {FORMAT_VERSION}")
+            count = sum(1 for key in data.files if key.startswith("hidden_") and key.endswith("_w"))
+            hidden = tuple((data[f"hidden_{i}_w"], data[f"hidden_{i}_b"]) for i in range(count))
+            return Policy(hidden=hidden, mean=(data["mean_w"], data["mean_b"]),
+                          observation_layout=tuple((str(k), int(s)) for k, s in meta["observation_layout"]),
+                          action_low=data["action_low"].astype(np.float64),
+                          action_high=data["action_high"].astype(np.float64),
+                          fingerprint=str(meta["fingerprint"]), info=dict(meta.get("info", {})))
+    except FileNotFoundError:
+        raise ValueError(f"{path}: no such policy file") from None
+    except (KeyError, OSError, zipfile.BadZipFile, json.JSONDecodeError, TypeError, AttributeError) as error:
+        raise ValueError(f"{path}: not a policy file ({type(error).__name__}: {error})") from None
+
+
+def load_policy(name_or_path: str = "robostrich", env=None) -> Policy:
+    """A shipped policy by name (``SHIPPED``) or a policy file by path; with ``env``,
+    checked against it (:meth:`Policy.check`)."""
+    path = SHIPPED.get(name_or_path)
+    if path is None:
+        path = pathlib.Path(name_or_path)
+        if path.suffix != ".npz":
+            raise ValueError(f"unknown policy {name_or_path!r}: a shipped one ({', '.join(SHIPPED)}) "
+                             f"or a .npz policy file")
+    policy = read_policy(path)
+    if env is not None:
+        policy.check(env)
+    return policy

@@ -1,0 +1,88 @@
+"""Shipped policies: the default robot's policy reaches its targets with numpy alone, a policy
+refuses a robot it was not trained on, an exported policy acts as its run's evaluation actor,
+and robostrich-play runs it as an installed command."""
+import dataclasses
+import json
+import subprocess
+
+import numpy as np
+import pytest
+from conftest import console_script
+
+import robostrich_suite
+from agents.curriculum import CurriculumRun, parse_plan
+from agents.evaluation import evaluate_track
+from agents.policy_export import export_policy
+from agents.sac.builder import SACBuilder
+from agents.sac.config import SACConfig
+from robostrich_suite import policies
+from robostrich_suite.model import layouts
+
+
+def test_shipped_policy_reaches_every_track_target():
+    policy = robostrich_suite.load_policy("robostrich")
+    report = evaluate_track(policy, policy.flatten, "robostrich")
+    assert len(report["segments"]) == 3
+    assert report["summary"]["success_rate"] == 1.0, [s["final_position_error"] for s in report["segments"]]
+
+
+def test_policy_refuses_another_robot():
+    policy = robostrich_suite.load_policy("robostrich")
+    other = robostrich_suite.load("robostrich", "lesson2", task_kwargs=layouts.task_kwargs("antagonist_pairs"))
+    with pytest.raises(policies.PolicyMismatch, match="trained on model"):
+        policy.check(other)
+    with pytest.raises(policies.PolicyMismatch):
+        robostrich_suite.load_policy("robostrich", other)
+    own = robostrich_suite.load("robostrich", "lesson2")
+    policy.check(own)  # its own robot passes, and track, which observes more than the policy reads
+    policy.check(robostrich_suite.load("robostrich", "track"))
+    reads_more = dataclasses.replace(policy, observation_layout=policy.observation_layout + (("gaze", 2),))
+    with pytest.raises(policies.PolicyMismatch, match="gaze"):
+        reads_more.check(own)
+
+
+def test_policy_file_errors_name_the_file(tmp_path):
+    bad = tmp_path / "bad.npz"
+    np.savez(bad, something=np.zeros(3))
+    with pytest.raises(ValueError, match="bad.npz: not a policy file"):
+        policies.load_policy(str(bad))
+    with pytest.raises(ValueError, match="no such policy file"):
+        policies.load_policy(str(tmp_path / "missing.npz"))
+    with pytest.raises(ValueError, match="unknown policy 'nope'"):
+        policies.load_policy("nope")
+
+
+def test_exported_policy_acts_as_its_runs_evaluation_actor(tmp_path):
+    config = SACConfig(batch_size=16, hidden_sizes=(16, 16), min_replay_size=50, max_replay_size=2000)
+    run = CurriculumRun(parse_plan("lesson1:300"), config, seed=3, run_dir=str(tmp_path / "run"),
+                        checkpoint_every=300)
+    run.run()
+    path = tmp_path / "policy.npz"
+    policy = export_policy(str(tmp_path / "run" / "checkpoint.pkl"), str(path), command="a test")
+    again = policies.read_policy(path)
+    assert again.info["seed"] == 3 and again.info["command"] == "a test"
+    assert again.info["layout"] == layouts.DEFAULT
+    actor = SACBuilder.make_eval_actor(run.loop)
+    env = robostrich_suite.load("robostrich", "lesson1", task_kwargs={"random": 0})
+    again.check(env)
+    timestep = env.reset()
+    for _ in range(20):
+        flat = run.loop.flattener(timestep.observation)
+        expected = actor.select_action(flat)
+        np.testing.assert_allclose(again(timestep), expected, rtol=0, atol=1e-5)
+        timestep = env.step(expected)
+
+
+def test_play_runs_the_shipped_policy_as_an_installed_command(tmp_path):
+    result = subprocess.run([console_script("robostrich-play"), "--num-targets", "2", "--out", "played"],
+                            cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert "track    100.0 % reached" in result.stdout, result.stdout
+    report = json.loads((tmp_path / "played" / "policy_heldout.json").read_text())
+    assert report["summary"]["episodes"] == 2
+    assert (tmp_path / "played" / "policy_track.png").stat().st_size > 10_000
+    assert (tmp_path / "played" / "policy_track.rrd").stat().st_size > 0
+    bad = subprocess.run([console_script("robostrich-play"), "--policy", "nope.npz"], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and bad.stderr.strip().count("\n") == 0, bad.stderr
+    assert "nope.npz: no such policy file" in bad.stderr
