@@ -8,18 +8,84 @@ point in setup.py, which calls `run(main, prog, argv)`:
     2    an expected user error: ValueError (bad values, damaged or mismatched
          checkpoints), OSError (a missing file or directory, ...); one line
          `PROG: error: MESSAGE` on stderr, no traceback
-    130  interrupted (Ctrl-C)
+    130  interrupted (Ctrl-C), also when a library swallowed the KeyboardInterrupt; a long
+         loop that polls `interrupted()` inside `deferred_interrupts()` stops where its
+         state is whole (training writes a checkpoint first)
 
-argparse's own usage errors keep their usual exit status 2 and `--help` 0.
-Anything else is a bug and keeps its traceback.
+Usage errors (`Parser`) are one line too, exit status 2; `--help` exits 0.  Anything
+else is a bug and keeps its traceback.
+
+Every count, duration and size a command accepts has an upper bound (the `MAX_*`
+limits below, named in the error), so no flag asks for days or terabytes by accident.
 """
 from __future__ import annotations
 
+import argparse
+import contextlib
+import math
+import signal
 import sys
+import threading
 from typing import Callable, Optional, Sequence
 
 USER_ERROR = 2
 INTERRUPTED = 130
+
+# Generous but finite limits of what a flag may ask for.
+MAX_COUNT = 10_000_000  # samples, targets, rollouts: more than a day of simulation on 2 cores
+MAX_SECONDS = 600.0  # simulated seconds of one episode, hold or ramp
+MAX_WORKERS = 256  # processes
+MAX_SEED = 2**31 - 1 - 100_000  # seeds with offsets added stay 32-bit
+
+_interrupted = False
+_deferred = 0
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with a one-line usage error (`PROG: error: ...`, exit 2): the usage of a
+    command with fifty options would bury the line that matters."""
+
+    def error(self, message):
+        self.exit(USER_ERROR, f"{self.prog}: error: {' '.join(message.split())} (--help lists the options)\n")
+
+
+def interrupted() -> bool:
+    """Whether Ctrl-C came since the command started (polled by loops inside `deferred_interrupts`)."""
+    return _interrupted
+
+
+def raise_if_interrupted() -> None:
+    """KeyboardInterrupt if Ctrl-C came and was not acted on (deferred, or swallowed by a library
+    that caught it in a callback): long loops call it once per step."""
+    if _interrupted and not _deferred:
+        raise KeyboardInterrupt
+
+
+def _on_sigint(signum, frame):
+    global _interrupted
+    _interrupted = True
+    if not _deferred:
+        raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def deferred_interrupts():
+    """Inside the block Ctrl-C only sets `interrupted()`, for a loop to poll between chunks: a
+    KeyboardInterrupt raised anywhere can land in an XLA callback (which swallows it) or leave
+    half-made state behind."""
+    global _deferred, _interrupted
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.getsignal(signal.SIGINT) if main_thread else _on_sigint
+    if previous is not _on_sigint:
+        signal.signal(signal.SIGINT, _on_sigint)
+    _deferred += 1
+    try:
+        yield
+    finally:
+        _deferred -= 1
+        if previous is not _on_sigint:  # outside `run` (a Python caller): the loop has acted on it
+            signal.signal(signal.SIGINT, previous)
+            _interrupted = False
 
 
 def error_message(error: BaseException) -> str:
@@ -32,48 +98,68 @@ def error_message(error: BaseException) -> str:
 
 
 def run(main: Callable, prog: str, argv: Optional[Sequence[str]] = None) -> int:
-    """Call `main(argv)` as a console script would: an exit status instead of a return value."""
+    """Call `main(argv)` as a console script would: an exit status instead of a return value.
+    Ctrl-C after `main` returned only sets the flag: the command is done, and a
+    KeyboardInterrupt in the interpreter's exit would end it by the signal instead of 130."""
+    global _interrupted, _deferred
+    _interrupted, _deferred = False, 0
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, _on_sigint)
     try:
         main(argv)
-    except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
-        return INTERRUPTED
+        status, detail = (INTERRUPTED if _interrupted else 0), ""  # a library swallowed the KeyboardInterrupt
+    except KeyboardInterrupt as error:
+        status, detail = INTERRUPTED, error_message(error) if str(error) else ""
     except (ValueError, OSError) as error:
         sys.stdout.flush()
         print(f"{prog}: error: {error_message(error)}", file=sys.stderr)
         return USER_ERROR
-    return 0
+    finally:
+        _deferred += 1
+    if status == INTERRUPTED:
+        print(f"{prog}: interrupted" + (f" ({detail})" if detail else ""), file=sys.stderr)
+    return status
 
 
 def _number(kind, text: str):
-    import argparse
     try:
         return kind(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"invalid {'whole number' if kind is int else 'number'}: {text!r}") from None
 
 
-def whole_number(minimum: int):
-    """argparse type: an int >= minimum (a usage error naming the flag otherwise)."""
-    import argparse
+def whole_number(minimum: int, maximum: int = MAX_COUNT):
+    """argparse type: an int in [minimum, maximum] (a usage error naming the flag otherwise)."""
 
     def parse(text: str) -> int:
         value = _number(int, text)
-        if value < minimum:
-            raise argparse.ArgumentTypeError(f"must be at least {minimum}, got {text}")
+        if not minimum <= value <= maximum:
+            raise argparse.ArgumentTypeError(f"must be from {minimum} to {maximum}, got {text}")
         return value
     return parse
 
 
-def seconds(allow_zero: bool = False):
-    """argparse type: a finite number of seconds, > 0 (or >= 0 with allow_zero); NaN is refused."""
-    import argparse
-    import math
+def seconds(allow_zero: bool = False, maximum: float = MAX_SECONDS):
+    """argparse type: a finite number of seconds, > 0 (or >= 0 with allow_zero), at most `maximum`."""
 
     def parse(text: str) -> float:
         value = _number(float, text)
-        if not math.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
+        if not (math.isfinite(value) and value <= maximum and (value > 0 or (allow_zero and value == 0))):
             raise argparse.ArgumentTypeError(
-                f"must be a finite number of seconds {'>= 0' if allow_zero else '> 0'}, got {text}")
+                f"must be a number of seconds {'>= 0' if allow_zero else '> 0'} and at most {maximum:g}, got {text}")
         return value
     return parse
+
+
+def number(minimum: float, maximum: float, unit: str = ""):
+    """argparse type: a finite float in [minimum, maximum] (NaN and infinities refused)."""
+
+    def parse(text: str) -> float:
+        value = _number(float, text)
+        if not (math.isfinite(value) and minimum <= value <= maximum):
+            raise argparse.ArgumentTypeError(f"must be a number from {minimum:g} to {maximum:g}{unit}, got {text}")
+        return value
+    return parse
+
+
+seed = whole_number(0, MAX_SEED)

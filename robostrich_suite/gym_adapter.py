@@ -114,11 +114,10 @@ class GymnasiumEnv(gymnasium.Env):
             gymnasium.logger.warn("render() called without a render_mode; make the environment "
                                   "with render_mode='rgb_array'")
             return None
+        import mujoco
         physics = self.dm_env.physics
-        try:
-            camera = physics.model.name2id(self.camera, "camera")
-        except ValueError:
-            camera = -1  # a model without that camera: MuJoCo's free camera
+        # -1 (MuJoCo's free camera) for a model without that camera
+        camera = mujoco.mj_name2id(physics.model.ptr, mujoco.mjtObj.mjOBJ_CAMERA, str(self.camera))
         return physics.render(height=self.height, width=self.width, camera_id=camera)
 
 

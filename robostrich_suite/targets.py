@@ -15,12 +15,15 @@ from __future__ import annotations
 
 import functools
 import pathlib
+import zipfile
+import zlib
 
 import numpy as np
 
 DATA_PATH = pathlib.Path(__file__).parent / "data" / "level_head_poses.npz"
 HELDOUT_EVERY = 5
 MIN_TARGET_SPACING = 0.01  # m
+FIELDS = ("head_position", "head_attitude", "control", "fingerprint")  # of a target file
 
 
 @functools.lru_cache(maxsize=None)
@@ -29,8 +32,21 @@ def _load(path: str = str(DATA_PATH)) -> dict:
     if not path.exists():
         raise FileNotFoundError(
             f"{path} is missing; regenerate it with `robostrich-targets --out {path}`")
-    with np.load(path) as data:
-        return {key: data[key] for key in data.files}
+    try:
+        with np.load(path) as data:
+            poses = {key: data[key] for key in data.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as error:
+        raise ValueError(f"{path} is not a target file (a damaged or truncated .npz?): "
+                         f"{type(error).__name__}: {error}") from None
+    missing = [key for key in FIELDS if key not in poses]
+    if missing:
+        raise ValueError(f"{path} is not a target file: it lacks {missing} (it holds {sorted(poses)})")
+    count = len(poses["head_position"])
+    if (poses["head_position"].shape != (count, 2) or poses["head_attitude"].shape != (count,)
+            or poses["control"].ndim != 2 or len(poses["control"]) != count):
+        raise ValueError(f"{path} is not a target file: head_position {poses['head_position'].shape}, head_attitude "
+                         f"{poses['head_attitude'].shape} and control {poses['control'].shape} do not match")
+    return poses
 
 
 def level_head_poses(path: str | pathlib.Path = DATA_PATH) -> dict:

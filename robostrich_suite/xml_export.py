@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import pathlib
 
+from robostrich_suite import cli as cli_lib
+
 
 def _robostrich():
     from robostrich_suite import robostrich
@@ -38,8 +40,7 @@ def export(directory: pathlib.Path) -> list[pathlib.Path]:
 
 
 def main(argv=None) -> None:
-    import argparse
-    parser = argparse.ArgumentParser(description="Write the generated MJCF of the default models.")
+    parser = cli_lib.Parser(description="Write the generated MJCF of the default models.")
     parser.add_argument("--out", type=pathlib.Path, required=True,
                         help="directory to write into (the checked-in copies: the repository's xml/)")
     args = parser.parse_args(argv)
@@ -49,7 +50,6 @@ def main(argv=None) -> None:
 
 def cli(argv=None) -> int:
     """Console script `robostrich-export-xml`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
-    from robostrich_suite import cli as cli_lib
     return cli_lib.run(main, "robostrich-export-xml", argv)
 
 

@@ -163,7 +163,7 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     assert results["checkpoint_every_0"].returncode == 2 and not (tmp_path / "ck0").exists()
     assert_user_error(results["truncated"], "truncated.pkl", "damaged")
     assert_user_error(results["empty"], "empty.pkl", "not a robostrich SAC checkpoint")
-    assert_user_error(results["ramp_negative"], "ramp_time")
+    assert_user_error(results["ramp_negative"], "--ramp-time")
     assert not list(tmp_path.glob("mv/*.rrd"))  # refused before the recording was opened
     assert_user_error(results["layout"], "unknown layout 'tangled'")
     assert_user_error(results["task"], "no task 'lesson9'")

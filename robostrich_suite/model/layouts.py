@@ -49,6 +49,9 @@ DATA_DIR = pathlib.Path(__file__).resolve().parents[1] / "data"
 ANTAGONIST_CUTS = ("c18", "c13", "c9", "c5", "atlas")
 
 
+MAX_FILE_BYTES = 10_000_000  # a layout file is a few kB; anything this big is not one
+
+
 class LayoutFileError(ValueError):
     """A layout file that cannot be read as a layout; the message names file and item."""
 
@@ -259,7 +262,12 @@ def read_file(path, spec: arm_lib.ArmSpec | None = None) -> tuple[str, arm_lib.T
     """``(name, layout)`` from a ``.json`` or ``.toml`` file; the name defaults to the
     file's stem."""
     path = pathlib.Path(path)
-    text = path.read_text(encoding="utf-8")  # a missing file is an OSError naming it
+    if path.stat().st_size > MAX_FILE_BYTES:  # a missing file is an OSError naming it
+        raise LayoutFileError(f"{path}: {path.stat().st_size} bytes, more than a layout file's {MAX_FILE_BYTES}")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as error:
+        raise LayoutFileError(f"{path}: not a UTF-8 text file (byte {error.start} cannot be decoded)") from None
     suffix = path.suffix.lower()
     try:
         if suffix == ".json":
@@ -270,9 +278,10 @@ def read_file(path, spec: arm_lib.ArmSpec | None = None) -> tuple[str, arm_lib.T
         else:
             raise LayoutFileError(f"{path}: unknown layout file type {path.suffix!r}; "
                                   "use .json or .toml")
-    except (json.JSONDecodeError, ValueError) as error:
+    except (json.JSONDecodeError, ValueError, RecursionError) as error:
         if isinstance(error, LayoutFileError):
             raise
-        raise LayoutFileError(f"{path}: not valid {suffix[1:].upper()}: {error}") from None
+        what = "nested too deeply" if isinstance(error, RecursionError) else str(error)
+        raise LayoutFileError(f"{path}: not valid {suffix[1:].upper()}: {what}") from None
     layout = from_dict(data, spec, source=str(path))
     return data.get("name") or path.stem, layout

@@ -25,14 +25,16 @@ def sample_trot(gait: gait_lib.TrotGait | None = None, cycles: int = 1, rate: fl
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(prog="robostrich-gait", description="Write a trot as a gait file (CSV).")
+    parser = cli_lib.Parser(prog="robostrich-gait", description="Write a trot as a gait file (CSV).")
     parser.add_argument("--out", type=pathlib.Path, required=True,
                         help="gait file to write (the shipped one: robostrich_suite/data/a1_trot.csv)")
-    parser.add_argument("--frequency", type=float, default=gait_lib.TrotGait.frequency)
-    parser.add_argument("--stride", type=float, default=gait_lib.TrotGait.stride)
-    parser.add_argument("--lift", type=float, default=gait_lib.TrotGait.lift)
+    parser.add_argument("--frequency", type=cli_lib.number(0.1, 20, " Hz"), default=gait_lib.TrotGait.frequency,
+                        help="gait cycles per second, 0.1-20 (default: %(default)s)")
+    parser.add_argument("--stride", type=cli_lib.number(0, 0.2, " m"), default=gait_lib.TrotGait.stride)
+    parser.add_argument("--lift", type=cli_lib.number(0, 0.1, " m"), default=gait_lib.TrotGait.lift)
     parser.add_argument("--trunk-height", type=float, default=gait_lib.TrotGait.trunk_height)
-    parser.add_argument("--rate", type=float, default=100.0, help="samples per second")
+    parser.add_argument("--rate", type=cli_lib.number(1, 10_000, " samples/s"), default=100.0,
+                        help="samples per second, 1-10000 (default: %(default)s)")
     args = parser.parse_args(argv)
     gait = gait_lib.TrotGait(args.frequency, args.stride, args.lift, args.trunk_height)
     times, targets = sample_trot(gait, rate=args.rate)

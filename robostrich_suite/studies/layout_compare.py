@@ -24,7 +24,6 @@ level poses, and the routing on a stick figure, per case) and ``targets/CASE.npz
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import dataclasses
 import pathlib
@@ -315,16 +314,9 @@ def write_csv(path: pathlib.Path, rows) -> None:
 
 # --------------------------------------------------------------------------- command line
 
-def _positive_float(text):
-    value = float(text)
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be positive, got {text}")
-    return value
-
-
 def main(argv=None) -> dict:
     """Command line: measure the cases, write the table, the CSV, the figure and the targets."""
-    parser = argparse.ArgumentParser(
+    parser = cli_lib.Parser(
         prog=PROG,
         description="Compare tendon layouts (and passive joint stiffnesses) of the Robostrich "
                     "arm on the same Table 1 links: share of the blue region of Fig. 6 held "
@@ -347,7 +339,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--layout-file", nargs="+", default=[], type=pathlib.Path, metavar="FILE",
                         help="also compare layouts from JSON/TOML files (see "
                              "robostrich_suite/model/layouts.py for the format)")
-    parser.add_argument("--stiffness", nargs="+", type=_positive_float, default=[],
+    parser.add_argument("--stiffness", nargs="+", type=cli_lib.number(1e-6, 1e4, " N m/rad"), default=[],
                         metavar="N_M_PER_RAD",
                         help="passive joint stiffnesses to sweep, every layout at each "
                              "(default: the arm's own)")
@@ -359,7 +351,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--seek-time", type=cli_lib.seconds(), default=pose_seek.SEEK_TIME,
                         help="seconds of input adjustment per sought blue-region pose "
                              "(default: %(default)s)")
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    parser.add_argument("--seed", type=cli_lib.seed, default=0, help="random seed (default: %(default)s)")
     parser.add_argument("--no-movement", action="store_true", help="skip the rolling/lever tests")
     parser.add_argument("--no-lookup", action="store_true", help="skip the lookup baseline")
     parser.add_argument("--train", action="store_true",
@@ -367,7 +359,7 @@ def main(argv=None) -> dict:
                              "report its held-out success")
     parser.add_argument("--train-steps", type=cli_lib.whole_number(1), default=DEFAULT_TRAIN_STEPS,
                         help="control steps of that run, split over lessons 1-3 (default: %(default)s)")
-    parser.add_argument("--workers", type=cli_lib.whole_number(1), default=1,
+    parser.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS), default=1,
                         help="processes, one case each (default: %(default)s)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)

@@ -12,7 +12,6 @@ measurements, the settings tried and why are in ``docs/movement.md``.
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import pathlib
 import time
@@ -20,6 +19,7 @@ import time
 import numpy as np
 from dm_control.rl import control as control_lib
 
+from robostrich_suite import cli as cli_lib
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite.model import scenes
@@ -355,17 +355,13 @@ def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int
 
 # --------------------------------------------------------------------------- command line
 
-def _positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a positive number of joints, got {value}")
-    return value
+MAX_RAMP_TIME = 60.0  # s per tendon: the whole test is about 8 of them
 
 
 def main(argv=None) -> dict:
     """Command line: run both patterns, write a PNG and a Rerun recording of each."""
     from robostrich_suite.studies import movement_figure
-    parser = argparse.ArgumentParser(
+    parser = cli_lib.Parser(
         prog="robostrich-movement",
         description="The paper's movement tests (Sec. 4.3, Figs. 4-5): rolling and lever "
                     "patterns of the ventral tendons while the dorsal tendon is held. Writes "
@@ -381,14 +377,14 @@ def main(argv=None) -> dict:
                              "held, successive contractions; overrides --ventral-span, "
                              "--dorsal-hold, --ramp-time and --no-release")
     defaults = MovementConfig()
-    parser.add_argument("--ventral-span", type=_positive_int, default=defaults.ventral_span,
+    parser.add_argument("--ventral-span", type=cli_lib.whole_number(1, 17), default=defaults.ventral_span,
                         metavar="K", help="ventral slips tied K joints caudal of their "
                         "insertions (TendonLayout.ventral_slips) (default: %(default)s)")
-    parser.add_argument("--dorsal", type=float, default=defaults.dorsal,
+    parser.add_argument("--dorsal", type=cli_lib.number(-0.5, 0.5, " m"), default=defaults.dorsal,
                         help="dorsal contraction held throughout, m (default: %(default)s)")
-    parser.add_argument("--amplitude", type=float, default=defaults.amplitude,
+    parser.add_argument("--amplitude", type=cli_lib.number(-0.5, 0.5, " m"), default=defaults.amplitude,
                         help="ventral contraction per tendon, m (default: %(default)s)")
-    parser.add_argument("--ramp-time", type=float, default=defaults.ramp_time,
+    parser.add_argument("--ramp-time", type=cli_lib.seconds(maximum=MAX_RAMP_TIME), default=defaults.ramp_time,
                         help="seconds per ventral tendon (default: %(default)s)")
     parser.add_argument("--dorsal-hold", choices=("length", "input"),
                         default=defaults.dorsal_hold,
@@ -399,11 +395,11 @@ def main(argv=None) -> dict:
     parser.add_argument("--no-match-travel", action="store_true",
                         help="ramp the lever to --amplitude instead of bisecting its amplitude "
                              "until its head travel equals the rolling pattern's")
-    parser.add_argument("--joint-stiffness", type=float, default=None,
+    parser.add_argument("--joint-stiffness", type=cli_lib.number(0, 1e4, " N m/rad"), default=None,
                         help="override the passive joint stiffness, N m/rad (default: the arm's)")
-    parser.add_argument("--seed", type=int, default=0,
+    parser.add_argument("--seed", type=cli_lib.seed, default=0,
                         help="seed of --pose-family's random inputs (default: %(default)s)")
-    parser.add_argument("--pose-family", type=int, default=0, metavar="N",
+    parser.add_argument("--pose-family", type=cli_lib.whole_number(0, 100_000), default=0, metavar="N",
                         help="also settle N random ventral inputs at the held dorsal length and "
                              "print how tightly the attitude follows the head position "
                              "(about 0.1 s each; default: %(default)s)")
@@ -466,7 +462,6 @@ def main(argv=None) -> dict:
 
 def cli(argv=None) -> int:
     """Console script `robostrich-movement`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
-    from robostrich_suite import cli as cli_lib
     return cli_lib.run(main, "robostrich-movement", argv)
 
 

@@ -46,6 +46,10 @@ def generate(num_samples: int, seed: int = 0, path: pathlib.Path = targets.DATA_
     targets for another arm; write them to another ``path`` and pass
     ``training_targets(path)`` as the tasks' ``target_pool``.
     """
+    fingerprint = fingerprint_lib.model_fingerprint(spec, layout)
+    old = targets.level_head_poses(path) if append and path.exists() else None  # checked before drawing
+    if old is not None and str(old["fingerprint"]) != fingerprint:
+        raise ValueError(f"{path} was made with another arm; regenerate without --append")
     parts = []
     if num_samples > 0:
         parts.append(workspace.actuated_samples_parallel(num_samples, seed=seed, workers=workers,
@@ -58,14 +62,10 @@ def generate(num_samples: int, seed: int = 0, path: pathlib.Path = targets.DATA_
         raise ValueError("nothing to draw: give samples and/or blue samples")
     samples = workspace.ActuatedSamples.concatenate(parts)
     level = samples.level()
-    fingerprint = fingerprint_lib.model_fingerprint(spec, layout)
     new = dict(head_position=samples.head_position[level],
                head_attitude=samples.head_attitude[level], control=samples.control[level])
-    if append and path.exists():
-        with np.load(path) as old:
-            if str(old["fingerprint"]) != fingerprint:
-                raise ValueError(f"{path} was made with another arm; regenerate without --append")
-            new = {key: np.concatenate([old[key], value]) for key, value in new.items()}
+    if old is not None:
+        new = {key: np.concatenate([old[key], value]) for key, value in new.items()}
     return save_level_poses(path, new, fingerprint)
 
 
@@ -129,24 +129,30 @@ def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str) -> int:
     of the arm with ``fingerprint``; returns how many.  Readers of ``path`` see the new file."""
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(path, fingerprint=np.array(fingerprint),
-                        **{key: np.asarray(poses[key]) for key in ("head_position", "head_attitude",
-                                                                  "control")})
+    partial = path.with_name(path.name + ".partial")  # renamed over path once whole (Ctrl-C, a full disk)
+    try:
+        with open(partial, "wb") as handle:
+            np.savez_compressed(handle, fingerprint=np.array(fingerprint),
+                                **{key: np.asarray(poses[key]) for key in ("head_position", "head_attitude",
+                                                                          "control")})
+        partial.replace(path)
+    finally:
+        partial.unlink(missing_ok=True)
     targets.clear_cache()
     return len(poses["head_position"])
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(prog="robostrich-targets", description=__doc__.split("\n")[0])
+    parser = cli_lib.Parser(prog="robostrich-targets", description=__doc__.split("\n")[0])
     parser.add_argument("--samples", type=cli_lib.whole_number(0), default=4000,
                         help="random held inputs (default: %(default)s)")
     parser.add_argument("--blue-samples", type=cli_lib.whole_number(0), default=0,
                         help="kinematic samples whose level heads (the blue region) each get a sought "
                              "pose (default: %(default)s)")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=cli_lib.seed, default=0)
     parser.add_argument("--out", type=pathlib.Path, required=True,
                         help="target file to write (the shipped one: robostrich_suite/data/level_head_poses.npz)")
-    parser.add_argument("--seek-level-time", type=float, default=SEEK_LEVEL_TIME,
+    parser.add_argument("--seek-level-time", type=cli_lib.seconds(allow_zero=True), default=SEEK_LEVEL_TIME,
                         help="seconds of dorsal tuning towards a level head per draw (0: off)")
     parser.add_argument("--append", action="store_true",
                         help="add to the poses already in --out (use a new --seed)")
@@ -155,7 +161,7 @@ def main(argv=None) -> None:
                              "the poses still held level, at their new positions")
     parser.add_argument("--layout", default=None, metavar="NAME",
                         help="built-in tendon layout of the arm (default: the tasks' own)")
-    parser.add_argument("--workers", type=cli_lib.whole_number(1), default=2,
+    parser.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS), default=2,
                         help="processes drawing poses (default: %(default)s)")
     args = parser.parse_args(argv)
     layout = None

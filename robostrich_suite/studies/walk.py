@@ -17,6 +17,7 @@ import pathlib
 import numpy as np
 
 import robostrich_suite
+from robostrich_suite import cli as cli_lib
 from robostrich_suite import physics as physics_lib
 from robostrich_suite import rerun_log
 from robostrich_suite.robostrich_a1 import CONTROL_TIMESTEP, SUITE
@@ -105,8 +106,9 @@ def _at_least_one_step(text: str) -> float:
         seconds = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"invalid number: {text!r}") from None
-    if not seconds >= CONTROL_TIMESTEP:  # also NaN
-        raise argparse.ArgumentTypeError(f"must be at least one control step ({CONTROL_TIMESTEP} s), got {text}")
+    if not CONTROL_TIMESTEP <= seconds <= cli_lib.MAX_SECONDS:  # also NaN
+        raise argparse.ArgumentTypeError(f"must be from one control step ({CONTROL_TIMESTEP} s) to "
+                                         f"{cli_lib.MAX_SECONDS:g} s, got {text}")
     return seconds
 
 
@@ -125,7 +127,7 @@ def out_directory_problem(out: pathlib.Path) -> str | None:
 def main(argv=None) -> None:
     """The walk tool: trot with scripted tendons, write a Rerun recording and a PNG."""
     from robostrich_suite.studies import walk_figure
-    parser = argparse.ArgumentParser(
+    parser = cli_lib.Parser(
         description="Walk the quadruped with the arm on it; write walk.rrd and walk.png under --out "
                     "(trunk and head height, speed and attitude over time).")
     parser.add_argument("--task", default="head_stabilize", choices=list(SUITE),
@@ -141,7 +143,7 @@ def main(argv=None) -> None:
                         help="output directory: writes OUT/walk.rrd and OUT/walk.png "
                              "(default: %(default)s)")
     parser.add_argument("--no-rrd", action="store_true", help="skip the Rerun recording")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=cli_lib.seed, default=0)
     args = parser.parse_args(argv)
     problem = out_directory_problem(args.out)
     if problem:
@@ -164,7 +166,6 @@ def main(argv=None) -> None:
 
 def cli(argv=None) -> int:
     """Console script `robostrich-walk`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
-    from robostrich_suite import cli as cli_lib
     return cli_lib.run(main, "robostrich-walk", argv)
 
 

@@ -258,7 +258,7 @@ def save_samples(path: str | pathlib.Path, kinematic: KinematicSamples,
 
 def main(argv=None) -> dict:
     """Command line: sample both workspaces, write the figure and the samples."""
-    parser = argparse.ArgumentParser(
+    parser = cli_lib.Parser(
         prog="robostrich-workspace",
         description="Kinematic workspace of the Robostrich arm (paper Fig. 6: red = all head "
                     f"positions, blue = head level {LEVEL_ATTITUDE_DEG:g}+-{LEVEL_TOLERANCE_DEG:g} "
@@ -267,7 +267,7 @@ def main(argv=None) -> dict:
                     "workspace_samples.npz.")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/workspace"),
                         help="output directory (default: %(default)s)")
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
+    parser.add_argument("--seed", type=cli_lib.seed, default=0, help="random seed (default: %(default)s)")
     parser.add_argument("--samples", type=cli_lib.whole_number(0), default=200_000,
                         help="kinematic samples: uniform joint angles (default: %(default)s)")
     parser.add_argument("--edge-samples", type=cli_lib.whole_number(0), default=100_000,
@@ -283,7 +283,7 @@ def main(argv=None) -> dict:
                         help="tune each draw's dorsal input for a level head for this long "
                              "before holding it (about 12 times more level poses for 2.7 "
                              "times the time; default: %(default)s = off)")
-    parser.add_argument("--workers", type=cli_lib.whole_number(1), default=2,
+    parser.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS), default=2,
                         help="processes for the actuated sampling (default: %(default)s)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     args = parser.parse_args(argv)

@@ -47,6 +47,7 @@ import numpy as np
 from robostrich_suite.model import quadruped as quad
 
 DATA_PATH = pathlib.Path(__file__).resolve().parents[1] / "data" / "a1_trot.csv"
+MAX_FILE_BYTES = 100_000_000  # the shipped gait file is 30 kB
 # The leg servos (kp 100) sag under the robot's weight: measured trunk height minus
 # command, at 0.22-0.28 m, is -0.010 m standing and -0.019 m on average while trotting.
 # The tasks command the legs that much higher so the trunk's height matches the command.
@@ -306,6 +307,8 @@ def read_gait_file(path) -> tuple[np.ndarray, np.ndarray]:
     header_seen = False
     if not path.is_file():
         raise ValueError(f"{path}: no such gait file")
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise ValueError(f"{path}: {path.stat().st_size} bytes, more than a gait file's {MAX_FILE_BYTES}")
     try:  # utf-8-sig: a byte-order mark (spreadsheet exports) is not part of 'time'
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as error:
@@ -313,7 +316,8 @@ def read_gait_file(path) -> tuple[np.ndarray, np.ndarray]:
     if "\0" in text:
         raise ValueError(f"{path}: not a text gait file (it contains NUL bytes)")
     with io.StringIO(text, newline="") as handle:
-        for line_number, row in enumerate(csv.reader(handle), start=1):
+        reader = csv.reader(handle)
+        for line_number, row in enumerate(_rows(reader, path), start=1):
             if not row or not "".join(row).strip() or row[0].lstrip().startswith("#"):
                 continue
             cells = [cell.strip() for cell in row]
@@ -347,6 +351,18 @@ def read_gait_file(path) -> tuple[np.ndarray, np.ndarray]:
     return data[:, 0], data[:, 1:]
 
 
+def _rows(reader, path):
+    """The rows of a csv reader, its own errors (a field over csv's size limit, a NUL) as a
+    ValueError naming the file and line."""
+    while True:
+        try:
+            yield next(reader)
+        except StopIteration:
+            return
+        except csv.Error as error:
+            raise ValueError(f"{path}: line {reader.line_num}: {error}") from None
+
+
 def _is_float(text: str) -> bool:
     try:
         float(text)
@@ -368,4 +384,9 @@ def write_gait_file(path, times, targets, comment: str | None = None) -> None:
         out.write(",".join([f"{t:.6f}"] + [f"{v:.6f}" for v in row]) + "\n")
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(out.getvalue())
+    partial = path.with_name(path.name + ".partial")  # renamed over path once whole
+    try:
+        partial.write_text(out.getvalue())
+        partial.replace(path)
+    finally:
+        partial.unlink(missing_ok=True)

@@ -12,6 +12,7 @@ and joint-angle observations can carry Gaussian noise.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -30,11 +31,12 @@ class DomainRandomization:
     def __post_init__(self):
         for field in ("mass_scale", "stiffness_scale", "damping_scale", "tendon_gain_scale"):
             low, high = getattr(self, field)
-            if not 0 < low <= high:
-                raise ValueError(f"{field} must be (low, high) with 0 < low <= high, "
+            if not 0 < low <= high < math.inf:
+                raise ValueError(f"{field} must be (low, high) with 0 < low <= high, finite, "
                                  f"got {(low, high)}")
-        if self.joint_angle_noise < 0:
-            raise ValueError(f"joint_angle_noise must be >= 0, got {self.joint_angle_noise}")
+        if not 0 <= self.joint_angle_noise <= math.pi:  # NaN too
+            raise ValueError(f"joint_angle_noise must be a standard deviation from 0 to pi rad, "
+                             f"got {self.joint_angle_noise}")
 
 
 class Randomizer:

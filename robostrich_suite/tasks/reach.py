@@ -92,6 +92,9 @@ def _length(vector: np.ndarray) -> float:
     return math.sqrt(vector.dot(vector))
 
 
+MAX_TARGET_DISTANCE = 1.5  # m from the origin of the targets' frame: no arm reaches farther
+
+
 def as_targets(targets, name: str) -> np.ndarray:
     """(n, 2) finite head positions (x, z); one (2,) position is one target. Anything else (a
     (4, 3) or (1, 4) array) is an error, not silently reshaped into other targets."""
@@ -102,6 +105,11 @@ def as_targets(targets, name: str) -> np.ndarray:
         raise ValueError(f"{name} must be a non-empty (n, 2) array of (x, z) positions, got shape {array.shape}")
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must hold finite positions")
+    far = np.flatnonzero(np.linalg.norm(array, axis=1) > MAX_TARGET_DISTANCE)
+    if far.size:
+        raise ValueError(f"{name} holds {far.size} position(s) far outside any workspace, e.g. {array[far[0]].tolist()}: "
+                         f"more than {MAX_TARGET_DISTANCE} m from the origin (the arm is 0.67 m long, its base "
+                         "within 0.5 m of the frame's and the trunk's origin)")
     return array
 
 
@@ -234,6 +242,10 @@ class Reach(base.Task):
         self.desired_attitude = float(desired_attitude)
         self.weights = weights or rewards.RewardWeights()
         self.target_axes = tuple(target_axes)
+        if (len(self.target_axes) != 2 or len(set(self.target_axes)) != 2
+                or not all(isinstance(a, (int, np.integer)) and 0 <= a <= 2 for a in self.target_axes)):
+            raise ValueError(f"target_axes must be two different world axes (0 = x, 1 = y, 2 = z), "
+                             f"got {target_axes!r}")
         self._target_axes_index = physics_lib.as_slice(self.target_axes)
         if isinstance(randomization, dict):
             randomization = randomization_lib.DomainRandomization(**randomization)
