@@ -18,14 +18,14 @@ from agents import applications
 
 def _parser(description: str, out: str) -> argparse.ArgumentParser:
     from robostrich_suite import cli as cli_lib
-    parser = argparse.ArgumentParser(description=description)
+    parser = cli_lib.Parser(description=description)
     parser.add_argument("checkpoint", nargs="?", default=None,
                         help="checkpoint.pkl of robostrich-train on robostrich_a1 (label 'trained'); "
                              "without it only zero input and the lookup run")
     parser.add_argument("--reference", default=None, metavar="CHECKPOINT",
                         help="a second checkpoint to compare (label 'reference'), e.g. lessons 1-3 without lesson 4")
     parser.add_argument("--layout", default=None, help="built-in tendon layout (default: the checkpoints', else the tasks' own)")
-    parser.add_argument("--seeds", type=cli_lib.whole_number(1), default=5,
+    parser.add_argument("--seeds", type=cli_lib.whole_number(1, 1_000), default=5,
                         help="gait phases: seed k of N starts the gait k/(2N) of its period later (default 5)")
     parser.add_argument("--gait", default=None, metavar="CSV",
                         help="gait file of recorded motor data (format: robostrich_suite/tasks/gait.py); "
@@ -120,8 +120,8 @@ def stabilize_main(argv=None) -> dict:
                      os.path.join("out", "stabilize"))
     parser.add_argument("--settle", type=cli_lib.seconds(allow_zero=True), default=stabilization.SETTLE,
                         help=f"seconds at the start left out of the metrics (default {stabilization.SETTLE})")
-    parser.add_argument("--distance", type=float, default=None, help="P_d (m ahead of the trunk centre; default the task's)")
-    parser.add_argument("--height", type=float, default=None, help="head height above ground (m; default the task's)")
+    parser.add_argument("--distance", type=cli_lib.number(-2, 2, " m"), default=None, help="P_d (m ahead of the trunk centre; default the task's)")
+    parser.add_argument("--height", type=cli_lib.number(-2, 2, " m"), default=None, help="head height above ground (m; default the task's)")
     args = parser.parse_args(argv)
     if args.time_limit is not None and args.time_limit <= args.settle:
         raise ValueError(f"--time-limit {args.time_limit} s leaves nothing to score after --settle {args.settle} s")
@@ -179,7 +179,7 @@ def gap_main(argv=None) -> dict:
     parser.add_argument("--switch", choices=quadruped_tasks.NarrowGap.SWITCHES, default="time",
                         help="when the next sub-target becomes active: 'time' (the task's default, every "
                              "--steps-per-target control steps) or 'reached' (once the head is within 5 cm)")
-    parser.add_argument("--steps-per-target", type=cli_lib.whole_number(1), default=None,
+    parser.add_argument("--steps-per-target", type=cli_lib.whole_number(1, 100_000), default=None,
                         help=f"control steps per sub-target (default {quadruped_tasks.NARROW_GAP_STEPS_PER_TARGET})")
     args = parser.parse_args(argv)
     gait, policies = _setup(args)

@@ -22,6 +22,7 @@ import numpy as np
 
 from agents import probes
 from agents.domains import Domain, as_domain
+from robostrich_suite import cli as cli_lib
 
 DOMAIN = "robostrich_a1"
 RECORD_EVERY = 5  # control steps per recorded frame (module doc)
@@ -138,6 +139,7 @@ def rollout(env, policy: Policy, record: Callable, recorder=None) -> dict:
         recorder.log_step(env, None, timestep)
     rows, step, action = [], 0, None
     while not timestep.last():
+        cli_lib.raise_if_interrupted()  # a Ctrl-C some library swallowed
         if step % policy.action_repeat == 0:
             action = np.asarray(actor.select_action(flattener(timestep.observation)), np.float64)
         timestep = env.step(action)

@@ -62,6 +62,9 @@ def read_with_digest(path: str) -> tuple:
     if not isinstance(record, dict) or record.get("format_version") != FORMAT_VERSION:
         version = record.get("format_version") if isinstance(record, dict) else None
         raise CheckpointError(f"{path} has format version {version}, expected {FORMAT_VERSION}")
+    lacking = [k for k in ("fingerprint", "payload") if not isinstance(record.get(k), dict)]
+    if lacking:
+        raise CheckpointError(f"{path} lacks its {' and '.join(lacking)} (not a whole checkpoint)")
     return record, digest.hex()
 
 

@@ -17,6 +17,7 @@ from agents import checkpoint
 from agents.domains import as_domain
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
+from robostrich_suite import cli as cli_lib
 
 
 @dataclasses.dataclass(frozen=True)
@@ -33,7 +34,7 @@ def parse_plan(text: str, default_domain: str = "robostrich") -> List[Lesson]:
         try:
             name, steps = item.rsplit(":", 1)
             steps = int(float(steps))
-        except ValueError:
+        except (ValueError, OverflowError):
             raise ValueError(f"bad lesson {item!r}: expected [domain/]task:steps") from None
         domain, task = name.split("/", 1) if "/" in name else (default_domain, name)
         if steps <= 0:
@@ -271,10 +272,17 @@ class CurriculumRun:
     def save_checkpoint(self, path: Optional[str] = None):
         checkpoint.save(path or self.checkpoint_path, self.state_dict(), self.fingerprint())
 
+    # What `restore` reads from a checkpoint's payload (others are optional: older checkpoints lack them).
+    STATE_FIELDS = ("learner", "actor_key", "replay", "loop", "lesson_index", "lesson_steps", "environment")
+
     def restore(self, path: Optional[str] = None):
         path = path or self.checkpoint_path
         # Both sides upgraded: a task argument left out means the task's default, then as now.
         state = checkpoint.load(path, upgrade_fingerprint(self.fingerprint()), upgrade=upgrade_fingerprint)
+        missing = [k for k in self.STATE_FIELDS if k not in state] if isinstance(state, dict) else list(self.STATE_FIELDS)
+        if missing:
+            raise checkpoint.CheckpointError(f"{path} lacks the run state {missing} (not written by robostrich-train, "
+                                             "or by a version that stored less)")
         loop = self.loop
         loop.learner.set_state(state["learner"])
         loop.actor.update(loop.learner.policy_params)
@@ -296,7 +304,19 @@ class CurriculumRun:
     # -- Algorithm 1 -----------------------------------------------------------------------
     def run(self, progress=None, on_eval: Optional[Callable] = None, eval_at: Sequence[int] = (),
             stop_at_step: Optional[int] = None, chunk: int = 500):
-        """Run the remaining plan. `on_eval(run)` is called when env_steps hits a value in eval_at."""
+        """Run the remaining plan. `on_eval(run)` is called when env_steps hits a value in eval_at.
+        Ctrl-C stops it between chunks: a checkpoint is written, then KeyboardInterrupt raised.
+        An episode a lesson's end cuts off gets its metrics line too (``"cut": true``)."""
+        with cli_lib.deferred_interrupts():
+            self._run(progress, on_eval, eval_at, stop_at_step, chunk)
+
+    def _stop_if_interrupted(self, metrics_file):
+        if cli_lib.interrupted():
+            metrics_file.flush()
+            self.save_checkpoint()
+            raise KeyboardInterrupt(f"checkpoint written at step {self.loop.env_steps}: {self.checkpoint_path}")
+
+    def _run(self, progress, on_eval, eval_at, stop_at_step, chunk):
         loop = self.loop
         eval_at = sorted(set(int(s) for s in eval_at))
         metrics_file = open(self.metrics_path, "a")
@@ -313,6 +333,7 @@ class CurriculumRun:
 
         try:
             while not self.done:
+                self._stop_if_interrupted(metrics_file)
                 lesson = self.plan[self.lesson_index]
                 n = min(chunk, lesson.steps - self.lesson_steps)
                 n = min(n, self.checkpoint_every - loop.env_steps % self.checkpoint_every)
@@ -329,6 +350,9 @@ class CurriculumRun:
                 if progress is not None:
                     progress.update(ran, self)
                 if self.lesson_steps >= lesson.steps:  # next lesson; everything else carries over
+                    cut = loop.cut_episode()
+                    if cut is not None:
+                        on_episode(cut)
                     self.lesson_index += 1
                     self.lesson_steps = 0
                     if not self.done:
@@ -342,16 +366,43 @@ class CurriculumRun:
                 if crossed(before, loop.env_steps, self.checkpoint_every) or self.done:
                     metrics_file.flush()
                     self.save_checkpoint()
+            self._stop_if_interrupted(metrics_file)
         finally:
             metrics_file.close()
 
 
+def read_records(path: str) -> list:
+    """The records of a JSON-lines file (metrics.jsonl, evals.jsonl). A torn last line (a crash
+    mid-write; no checkpoint can include it) is dropped; any other bad line is a ValueError
+    naming the file and line."""
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        lines = f.read().split("\n")
+    records = []
+    for number, line in enumerate(lines, start=1):
+        if not line.strip():
+            continue
+        try:
+            record = json.loads(line)
+        except ValueError as error:
+            if number == len(lines):  # no newline after it: written in part
+                break
+            raise ValueError(f"{path}: line {number} is not a JSON record ({error})") from None
+        if not isinstance(record, dict):
+            raise ValueError(f"{path}: line {number} is not a JSON object")
+        records.append(record)
+    return records
+
+
 def _truncate_jsonl(path: str, max_env_steps: int):
+    """Keep the records of ``path`` a checkpoint at ``max_env_steps`` includes (and no torn line)."""
     if not os.path.exists(path):
         return
+    records = read_records(path)
+    kept = [r for r in records if r.get("env_steps", 0) <= max_env_steps]
     with open(path) as f:
-        lines = [l for l in f if l.strip()]
-    kept = [l for l in lines if json.loads(l).get("env_steps", 0) <= max_env_steps]
-    if len(kept) != len(lines):
+        torn = not f.read().endswith("\n")
+    if len(kept) != len(records) or torn:
         with open(path, "w") as f:
-            f.writelines(kept)
+            f.writelines(json.dumps(r) + "\n" for r in kept)

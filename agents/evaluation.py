@@ -19,8 +19,12 @@ import numpy as np
 
 from agents import probes
 from agents.curriculum import make_environment
-from agents.domains import MOVING_START_TASK, as_domain
+from agents.domains import MOVING_START_TASK, TRACK_TASK, as_domain
+from robostrich_suite import cli as cli_lib
 from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, PRECISE_POSITION_TOLERANCE
+
+MAX_TARGETS = 10_000  # held-out targets (or seeded episodes off the arm) of one evaluation
+target_count = cli_lib.whole_number(1, MAX_TARGETS)  # argparse type of the target counts
 
 
 def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dict:
@@ -35,6 +39,7 @@ def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dic
         recorder.log_step(env, None, timestep)
     step = 0
     while not timestep.last():
+        cli_lib.raise_if_interrupted()  # a Ctrl-C some library swallowed
         if step % action_repeat == 0:
             action = actor.select_action(flattener(timestep.observation))
         timestep = env.step(action)
@@ -103,6 +108,32 @@ def summarize(episodes) -> dict:
 def default_heldout_task(domain, final_task: str) -> str:
     """lesson2 on the arm: reward eq. 10 from the fixed initial pose, so every target starts alike."""
     return as_domain(domain).heldout_task(final_task)
+
+
+def check_heldout_task(domain, task: str) -> str:
+    """``task`` if it is a task of ``domain`` that takes one held-out target (on the arm, a
+    lesson; not ``track``, which sets its own), else a ValueError naming --heldout-task."""
+    domain = as_domain(domain)
+    try:
+        domain.check_task(task)
+        if domain.is_arm:
+            make_environment(domain, task, 0, target_pool=domain.heldout_targets(1)).close()
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"--heldout-task {task!r} cannot be evaluated on held-out targets: {error}") from None
+    return task
+
+
+def check_track_task(domain, requested: Optional[str]) -> Optional[str]:
+    """The track task to evaluate: ``requested`` where ``domain`` has it; None for '' or the
+    default ``track`` on a domain without it (the quadruped); any other name must be a task
+    of ``domain`` (ValueError naming --track-task), not skipped without a word."""
+    domain = as_domain(domain)
+    if requested and requested != TRACK_TASK:
+        try:
+            domain.check_task(requested)
+        except ValueError as error:
+            raise ValueError(f"--track-task: {error}") from None
+    return domain.track_task(requested)
 
 
 def heldout_targets(domain, num_targets: Optional[int] = None):
@@ -268,12 +299,31 @@ def _json_default(o):
     raise TypeError(f"not JSON serialisable: {type(o)}")
 
 
+def checked_fingerprint(path: str) -> dict:
+    """The (upgraded) fingerprint of a robostrich-train checkpoint, after checking that it holds
+    what a run is rebuilt from: a CheckpointError naming what it lacks, before anything is built."""
+    from agents import checkpoint
+    from agents.curriculum import CurriculumRun, upgrade_fingerprint
+    record, _ = checkpoint.read_with_digest(path)
+    fp = upgrade_fingerprint(record["fingerprint"])
+    missing = ([k for k in ("plan", "config", "seed") if k not in fp]
+               + [k for k in CurriculumRun.STATE_FIELDS if k not in record["payload"]])
+    if missing:
+        raise checkpoint.CheckpointError(f"{path} is not a whole robostrich-train checkpoint: it lacks {missing}")
+    return fp
+
+
+def checkpoint_domain(fingerprint: dict):
+    """The domain (and layout) a checkpoint's run trained its last lesson on."""
+    from agents.curriculum import parse_plan
+    return as_domain(parse_plan(fingerprint["plan"])[-1].domain, fingerprint.get("layout"))
+
+
 def load_run_from_checkpoint(path: str):
     """Rebuild the CurriculumRun that wrote `path` (its fingerprint holds config, plan and seed)."""
-    from agents import checkpoint
-    from agents.curriculum import CurriculumRun, parse_plan, upgrade_fingerprint
+    from agents.curriculum import CurriculumRun, parse_plan
     from agents.sac.config import SACConfig
-    fp = upgrade_fingerprint(checkpoint.read_fingerprint(path))
+    fp = checked_fingerprint(path)
     scratch = tempfile.mkdtemp(prefix="robostrich-evaluate-")  # the run's own files are left untouched
     try:
         run = CurriculumRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch,
@@ -286,7 +336,7 @@ def load_run_from_checkpoint(path: str):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description="Evaluate a checkpoint (and, on the arm, the lookup baseline): "
+    parser = cli_lib.Parser(description="Evaluate a checkpoint (and, on the arm, the lookup baseline): "
                                                  "held-out targets and the track task.")
     parser.add_argument("checkpoint", help="checkpoint.pkl written by robostrich-train")
     parser.add_argument("--out", default=None, help="report directory (default: next to the checkpoint)")
@@ -294,17 +344,21 @@ def main(argv=None):
     parser.add_argument("--heldout-task", default=None,
                         help="task for held-out targets (default: lesson2 on robostrich, else the last lesson)")
     parser.add_argument("--track-task", default="track", help="'' to skip")
-    parser.add_argument("--num-targets", type=int, default=None)
+    parser.add_argument("--num-targets", type=target_count, default=None,
+                        help=f"held-out targets (default: all; at most {MAX_TARGETS})")
     parser.add_argument("--no-rerun", action="store_true")
     parser.add_argument("--no-figures", action="store_true")
     args = parser.parse_args(argv)
+    fingerprint = checked_fingerprint(args.checkpoint)  # every input checked before the run is rebuilt
+    domain = checkpoint_domain(fingerprint)
+    track_task = check_track_task(domain, args.track_task)
+    from agents.curriculum import parse_plan
+    heldout_task = check_heldout_task(domain, args.heldout_task
+                                      or default_heldout_task(domain, parse_plan(fingerprint["plan"])[-1].task))
     run = load_run_from_checkpoint(args.checkpoint)
-    domain = run.domain()
     out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.checkpoint)), "evaluation")
     from agents.sac.builder import SACBuilder
     actor = SACBuilder.make_eval_actor(run.loop)
-    track_task = domain.track_task(args.track_task)
-    heldout_task = args.heldout_task or default_heldout_task(domain, run.plan[-1].task)
     reports = {args.label: evaluate_agent(actor, run.loop.flattener, out, args.label, domain, heldout_task,
                                           track_task or None, args.num_targets,
                                           env_steps=run.loop.env_steps, record=not args.no_rerun,
@@ -324,7 +378,6 @@ def main(argv=None):
 
 def cli(argv=None) -> int:
     """Console script `robostrich-evaluate`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
-    from robostrich_suite import cli as cli_lib
     return cli_lib.run(main, "robostrich-evaluate", argv)
 
 

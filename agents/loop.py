@@ -118,15 +118,25 @@ class EnvironmentLoop:
                 replay.end_episode()
                 self.episodes += 1
                 if on_episode is not None:
-                    position_error, attitude_error = probes.head_errors(env)
-                    on_episode({
-                        "env_steps": self.env_steps, "episode": self.episodes,
-                        "return": self.episode_return, "length": self.episode_length,
-                        "position_error": position_error, "attitude_error": attitude_error,
-                        "success": probes.is_success(position_error, attitude_error, *probes.tolerances(env)),
-                        "time": time.time(),
-                    })
+                    on_episode(self._episode_record())
         return self.env_steps - start
+
+    def _episode_record(self) -> dict:
+        position_error, attitude_error = probes.head_errors(self.env)
+        return {"env_steps": self.env_steps, "episode": self.episodes,
+                "return": self.episode_return, "length": self.episode_length,
+                "position_error": position_error, "attitude_error": attitude_error,
+                "success": probes.is_success(position_error, attitude_error, *probes.tolerances(self.env)),
+                "time": time.time()}
+
+    def cut_episode(self) -> Optional[dict]:
+        """Count the open episode that a lesson's end cuts off and return its metrics (``"cut":
+        true``), or None if none is open: without it the steps of cut episodes would be missing
+        from the metrics."""
+        if self.timestep is None or self.timestep.last() or self.episode_length == 0:
+            return None
+        self.episodes += 1
+        return {**self._episode_record(), "cut": True}
 
     def metrics_as_floats(self) -> dict:
         return {k: float(v) for k, v in self.latest_metrics.items()}

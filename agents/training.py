@@ -25,14 +25,16 @@ from typing import Optional
 import numpy as np
 
 from agents import evaluation
-from agents.curriculum import (CurriculumRun, Lesson, check_lesson_names, format_plan, parse_plan, run_files,
-                               run_identity, upgrade_fingerprint)
+from agents.curriculum import (CurriculumRun, Lesson, check_lesson_names, format_plan, parse_plan, read_records,
+                               run_files, run_identity, upgrade_fingerprint)
 from agents.domains import Domain
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
+from robostrich_suite import cli as cli_lib
 from robostrich_suite.model import layouts
 
 DEFAULT_TOTAL_STEPS = 480_000  # per run: 160k control steps per lesson; the two runs train side by side
+MAX_TOTAL_STEPS = 100_000_000  # per run: about three days on 2 CPU cores
 # On the arm domains the main job trains the tasks' own routing, the reconstruction of the paper's
 # Fig. 1B (robostrich_suite.model.layouts.DEFAULT); `--layout antagonist_pairs` trains the best
 # routing of our own.
@@ -142,14 +144,7 @@ class Progress:
             self.bar.close()
 
 
-def positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"invalid int value: {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a positive number of steps, got {value}")
-    return value
+positive_int = cli_lib.whole_number(1, MAX_TOTAL_STEPS)  # environment steps
 
 
 def _json_object(text: str) -> dict:
@@ -163,18 +158,18 @@ def _json_object(text: str) -> dict:
 
 
 def build_parser():
-    p = argparse.ArgumentParser(description="Train curriculum SAC (and a plain-SAC baseline) on the Robostrich arm.")
+    p = cli_lib.Parser(description="Train curriculum SAC (and a plain-SAC baseline) on the Robostrich arm.")
     p.add_argument("--out", default="runs/default", help="run directory")
     p.add_argument("--resume", action="store_true", help="continue from the checkpoints in --out")
     p.add_argument("--domain", default="robostrich")
-    p.add_argument("--steps", type=int, default=DEFAULT_TOTAL_STEPS,
+    p.add_argument("--steps", type=positive_int, default=DEFAULT_TOTAL_STEPS,
                    help="total environment steps of the curriculum, split evenly over its lessons")
     p.add_argument("--lessons", default=None,
                    help="lesson tasks, in order (default: the domain's curriculum: lesson1-3 on robostrich, "
                         "lesson1-4 on robostrich_a1)")
     p.add_argument("--plan", default=None,
                    help="explicit plan '[domain/]task:steps,...' (overrides --steps/--lessons)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=cli_lib.seed, default=0)
     p.add_argument("--layout", default=None,
                    help="built-in tendon layout of the arm; its own shipped level poses give the training and "
                         f"held-out targets and the lookup table (default on the arm domains: {DEFAULT_ARM_LAYOUT}, "
@@ -201,10 +196,10 @@ def build_parser():
                    help="environment steps between checkpoints (default: %(default)s)")
     p.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
                    help="also train plain SAC on the final lesson with the same total budget")
-    p.add_argument("--eval-every", type=int, default=None, help="held-out evaluation period (default: steps/6)")
-    p.add_argument("--num-eval-targets", type=int, default=20,
+    p.add_argument("--eval-every", type=positive_int, default=None, help="held-out evaluation period (default: steps/6)")
+    p.add_argument("--num-eval-targets", type=evaluation.target_count, default=20,
                    help="held-out targets in the periodic evaluations (the final one uses all)")
-    p.add_argument("--final-eval-targets", type=int, default=None,
+    p.add_argument("--final-eval-targets", type=evaluation.target_count, default=None,
                    help="held-out targets in the final evaluation (default: all)")
     p.add_argument("--heldout-task", default=None,
                    help="task for held-out evaluation (default: lesson2 on robostrich, i.e. eq. 10 from the "
@@ -213,10 +208,10 @@ def build_parser():
     p.add_argument("--no-rerun", action="store_true")
     p.add_argument("--no-figures", action="store_true")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--workers", type=positive_int, default=min(2, os.cpu_count() or 1),
+    p.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS), default=min(2, os.cpu_count() or 1),
                    help="runs trained at once, one process each (default: %(default)s; the curriculum and "
                         "the plain-SAC baseline are independent)")
-    p.add_argument("--stop-at-step", type=int, default=None, help=argparse.SUPPRESS)  # imitates a kill (tests)
+    p.add_argument("--stop-at-step", type=positive_int, default=None, help=argparse.SUPPRESS)  # imitates a kill (tests)
     add_config_arguments(p.add_argument_group("SAC (defaults: agents/sac/config.py)"))
     return p
 
@@ -264,7 +259,18 @@ def config_from_args(args, argv=None) -> SACConfig:
         explicit = _explicit_fields(argv)
         paper = SACConfig.paper_sac()
         values = {k: (v if k in explicit else getattr(paper, k)) for k, v in values.items()}
-    return SACConfig(**values)
+    try:
+        return SACConfig(**values)
+    except ValueError as error:  # SACConfig names its fields; the user typed flags
+        raise ValueError(_with_flags(str(error))) from None
+
+
+def _with_flags(message: str) -> str:
+    """``message`` with every SACConfig field name replaced by its flag(s), e.g. learning_rate -> --learning-rate."""
+    import re
+    flags = {f.name: "/".join(_config_flags(f.name)) for f in dataclasses.fields(SACConfig)}
+    return re.sub(r"\b(" + "|".join(sorted(flags, key=len, reverse=True)) + r")\b",
+                  lambda m: flags[m.group(1)], message)
 
 
 def _explicit_fields(argv) -> set:
@@ -282,14 +288,44 @@ def _explicit_fields(argv) -> set:
 
 def plan_from_args(args):
     if args.plan:
-        return parse_plan(args.plan, default_domain=args.domain)
+        plan = parse_plan(args.plan, default_domain=args.domain)
+        if sum(l.steps for l in plan) > MAX_TOTAL_STEPS:
+            raise ValueError(f"--plan asks for {sum(l.steps for l in plan)} steps, more than {MAX_TOTAL_STEPS}")
+        return plan
     if args.lessons is None:
         tasks = list(Domain(args.domain).curriculum())
     else:
-        tasks = [t for t in args.lessons.split(",") if t]
+        tasks = [t.strip() for t in args.lessons.split(",") if t.strip()]
+        if not tasks:
+            raise ValueError(f"--lessons {args.lessons!r} names no task, e.g. --lessons lesson1,lesson2")
+    if args.steps < len(tasks):
+        raise ValueError(f"--steps {args.steps} leaves a lesson without a step ({len(tasks)} lessons)")
     per = args.steps // len(tasks)
     steps = [per] * (len(tasks) - 1) + [args.steps - per * (len(tasks) - 1)]
     return [Lesson(args.domain, t, s) for t, s in zip(tasks, steps)]
+
+
+def lock_run_directory(out: str):
+    """Make ``out`` this run's (an exclusive flock on ``out/.lock``, held while the returned file
+    stays open): two runs writing one directory would interleave their records and overwrite each
+    other's checkpoints. A directory in use is a ValueError that changes nothing."""
+    import fcntl
+    os.makedirs(out, exist_ok=True)
+    path = os.path.join(out, ".lock")
+    handle = open(path, "a+")
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        handle.seek(0)
+        owner = handle.read().strip()
+        handle.close()
+        raise ValueError(f"{out} is in use by another robostrich-train ({path} is locked"
+                         f"{', process ' + owner if owner else ''}); wait for it to end or choose another --out") from None
+    handle.seek(0)
+    handle.truncate()
+    handle.write(f"{os.getpid()}\n")
+    handle.flush()
+    return handle
 
 
 def _previous_init_path(out: str) -> Optional[str]:
@@ -302,10 +338,8 @@ def _previous_init_path(out: str) -> Optional[str]:
 
 
 def read_jsonl(path):
-    if not os.path.exists(path):
-        return []
-    with open(path) as f:
-        return [json.loads(l) for l in f if l.strip()]
+    """The records of a run's metrics.jsonl or evals.jsonl (agents.curriculum.read_records)."""
+    return read_records(path)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -407,14 +441,24 @@ class _QueueProgress:
 
 
 def _worker(spec: RunSpec, job, queue):
-    """One run in its own process: restore its latest checkpoint (if any), train, evaluate."""
+    """One run in its own process: restore its latest checkpoint (if any), train, evaluate.
+    Ctrl-C (the terminal's, or the parent's on another run's error) writes a checkpoint first."""
+    import signal
     label = spec.label
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # the parent started it ignored
     try:
         run = spec.build(restore=True)
         queue.put(("steps", label, (run.loop.env_steps, lesson_text(run))))  # where a resumed run starts
         outcome = train_and_evaluate(run, job, _QueueProgress(queue, label))
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # done: a late request to stop changes nothing
         queue.put(("done", label, {k: v for k, v in outcome.items() if k != "reports"}))
-    except BaseException as error:  # the parent reports it; a traceback here would interleave the bar
+    except KeyboardInterrupt as error:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent asks again until it hears this
+        queue.put(("interrupted", label, str(error)))
+    except (ValueError, OSError) as error:  # a user error: the parent's one line says it all
+        from robostrich_suite import cli as cli_lib
+        queue.put(("user_error", label, cli_lib.error_message(error)))
+    except BaseException as error:  # a bug: its traceback follows, the parent names the run
         queue.put(("error", label, f"{type(error).__name__}: {error}"))
         raise
 
@@ -424,53 +468,75 @@ def _train_in_parallel(specs: dict, job: RunJob, progress, workers: int) -> dict
     independent, so on two cores the main job takes the time of one run. Workers restore from and
     write the same checkpoints as a sequential run, so results are identical and resumable."""
     import multiprocessing
-    import queue as queue_lib
     context = multiprocessing.get_context("spawn")
     queue = context.Queue()
     # One intra-op thread per worker; set before the spawned interpreters import JAX.
     saved = os.environ.get("XLA_FLAGS")
     os.environ["XLA_FLAGS"] = ((saved or "") + " --xla_cpu_multi_thread_eigen=false"
                                " intra_op_parallelism_threads=1").strip()
-    pending = list(specs)
-    active, outcomes, errors = {}, {}, {}
-    try:
-        while pending or active:
-            while pending and len(active) < workers:
-                label = pending.pop(0)
-                # the worker builds the run from the same seed, or restores it
-                process = context.Process(target=_worker, args=(specs[label], job, queue))
-                process.start()
-                active[label] = process
-            try:
-                kind, label, payload = queue.get(timeout=1.0)
-            except queue_lib.Empty:  # check for workers that died without a word
-                for label, process in list(active.items()):
-                    if not process.is_alive() and label not in outcomes:
-                        errors.setdefault(label, f"worker exited with status {process.exitcode}")
-                        del active[label]
-                continue
-            if kind == "steps":
-                progress.advance(payload[0], label, payload[1])
-            elif kind == "episode":
-                progress.on_episode(payload)
-            elif kind == "done":
-                outcomes[label] = payload
-                active.pop(label).join()
-            elif kind == "error":
-                errors[label] = payload
-                active.pop(label).join()
-    finally:
-        for process in active.values():
-            process.terminate()
-        if saved is None:
-            os.environ.pop("XLA_FLAGS", None)
-        else:
-            os.environ["XLA_FLAGS"] = saved
-    if errors:
-        raise RuntimeError("; ".join(f"{label}: {message}" for label, message in errors.items()))
+    active = {}
+    ends = {"done": {}, "error": {}, "user_error": {}, "interrupted": {}}  # how each run ended
+    with cli_lib.deferred_interrupts():
+        try:
+            _supervise(context, specs, job, progress, workers, queue, active, ends)
+        finally:
+            for process in active.values():
+                process.terminate()
+            if saved is None:
+                os.environ.pop("XLA_FLAGS", None)
+            else:
+                os.environ["XLA_FLAGS"] = saved
+    for kind, error in (("error", RuntimeError), ("user_error", ValueError), ("interrupted", KeyboardInterrupt)):
+        if ends[kind]:
+            raise error("; ".join(f"{label}: {message}" for label, message in ends[kind].items()))
+    outcomes = ends["done"]
     for label, outcome in outcomes.items():
         outcome["reports"] = evaluation.read_reports(job.out_eval, label)
     return outcomes
+
+
+def _supervise(context, specs, job, progress, workers, queue, active, ends):
+    """Start workers, forward their progress and collect how each ended (``ends``). On Ctrl-C or
+    a run's error no run is started, and the running ones are asked (SIGINT, once a second until
+    they answer) to write a checkpoint and stop."""
+    import queue as queue_lib
+    import signal
+    pending = list(specs)
+    while pending or active:
+        stopping = cli_lib.interrupted() or ends["error"] or ends["user_error"]
+        if stopping:
+            pending.clear()
+            for process in active.values():
+                if process.is_alive():
+                    os.kill(process.pid, signal.SIGINT)
+        while pending and len(active) < workers:
+            label = pending.pop(0)
+            # the worker builds the run from the same seed, or restores it; it starts with Ctrl-C
+            # ignored (a KeyboardInterrupt while it imports would print a traceback) and takes it
+            # up in _worker
+            ignored = signal.signal(signal.SIGINT, signal.SIG_IGN)
+            try:
+                process = context.Process(target=_worker, args=(specs[label], job, queue))
+                process.start()
+            finally:
+                signal.signal(signal.SIGINT, ignored)
+            active[label] = process
+        try:
+            kind, label, payload = queue.get(timeout=1.0)
+        except queue_lib.Empty:  # check for workers that died without a word
+            for label, process in list(active.items()):
+                if not process.is_alive():
+                    ends["interrupted" if stopping else "error"].setdefault(
+                        label, f"worker exited with status {process.exitcode}")
+                    del active[label]
+            continue
+        if kind == "steps":
+            progress.advance(payload[0], label, payload[1])
+        elif kind == "episode":
+            progress.on_episode(payload)
+        elif label in active:  # the first word on how it ended
+            ends[kind][label] = payload
+            active.pop(label).join()
 
 
 def main(argv=None):
@@ -488,8 +554,8 @@ def main(argv=None):
     check_task_kwargs(plan, args.layout, args.task_kwargs)
     check_action_change(args.task_kwargs, config)
     check_lesson_names(plan, config, args.layout)
-    heldout_task = args.heldout_task or domain.heldout_task(final.task)
-    track_task = domain.track_task(args.track_task)
+    heldout_task = evaluation.check_heldout_task(domain, args.heldout_task or domain.heldout_task(final.task))
+    track_task = evaluation.check_track_task(domain, args.track_task)
     run_plans = {"curriculum": plan}
     if args.baseline:
         run_plans["baseline"] = [Lesson(final.domain, final.task, total)]
@@ -523,7 +589,9 @@ def main(argv=None):
                                                         args.layout,
                                                         init.get("init_digest") if label == "curriculum" else None))
             checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
-    os.makedirs(args.out, exist_ok=True)
+            for records in run_files(os.path.join(args.out, label))[1:]:
+                read_records(records)  # a damaged line other than a torn last one, named
+    lock = lock_run_directory(args.out)  # held until this process ends
 
     boundaries = list(np.cumsum([l.steps for l in plan]))
     eval_every = args.eval_every or max(1, total // 6)
@@ -596,7 +664,6 @@ def main(argv=None):
 
 def cli(argv=None) -> int:
     """Console script `robostrich-train`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
-    from robostrich_suite import cli as cli_lib
     return cli_lib.run(main, "robostrich-train", argv)
 
 

@@ -213,6 +213,7 @@ def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = Non
         record, digest = record
     fingerprint = record["fingerprint"]
     missing = [k for k in ("plan", "config", "observation_layout", "action_size") if k not in fingerprint]
+    missing += [k for k in ("learner",) if k not in record["payload"]]
     if missing:
         raise TransferError(f"--init-from: {path} is not a robostrich-train checkpoint (no {', '.join(missing)})")
     source_domain = _single_domain(parse_plan(fingerprint["plan"]), f"the plan of {path}")

@@ -113,9 +113,36 @@ class SACConfig:
     # Fields that name lesson tasks (tuples here, lists in a fingerprint).
     LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons", "exploration_lessons")
 
+    # Upper bounds of the sizes (generous: far beyond any run measured; they keep a typo from
+    # asking for days of updates or terabytes of replay).
+    LIMITS: ClassVar[dict] = {"batch_size": 65_536, "updates_per_call": 1_000, "env_steps_per_call": 100_000,
+                              "action_repeat": 1_000, "min_replay_size": 10_000_000,
+                              "max_replay_size": 10_000_000}
+    MAX_HIDDEN_LAYERS: ClassVar[int] = 16
+    MAX_HIDDEN_SIZE: ClassVar[int] = 8_192
+
     def __post_init__(self):
-        if min(self.batch_size, self.updates_per_call, self.env_steps_per_call, self.action_repeat) <= 0:
-            raise ValueError("batch_size, updates_per_call, env_steps_per_call and action_repeat must be positive")
+        """Every field checked here, where it is owned: a bad value fails when the config is made
+        (robostrich-train names the flag), not as a NaN loss or a JAX error after training began."""
+        for name, limit in self.LIMITS.items():
+            value, low = getattr(self, name), 0 if name == "min_replay_size" else 1
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= limit:
+                raise ValueError(f"{name} must be a whole number from {low} to {limit}, got {value!r}")
+        hidden = tuple(self.hidden_sizes) if not isinstance(self.hidden_sizes, (str, int)) else None
+        if (not hidden or len(hidden) > self.MAX_HIDDEN_LAYERS
+                or not all(isinstance(h, (int, np.integer)) and 1 <= h <= self.MAX_HIDDEN_SIZE for h in hidden)):
+            raise ValueError(f"hidden_sizes must be 1 to {self.MAX_HIDDEN_LAYERS} layer widths, each from 1 to "
+                             f"{self.MAX_HIDDEN_SIZE}, e.g. 64,64; got {self.hidden_sizes!r}")
+        for name, high in (("learning_rate", 1.0), ("init_temperature", 1e6), ("reward_scale", 1e6)):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and 0 < value <= high):
+                raise ValueError(f"{name} must be a number > 0 and at most {high:g}, got {value}")
+        if not (np.isfinite(self.log_std_min) and np.isfinite(self.log_std_max)
+                and -20 <= self.log_std_min < self.log_std_max <= 20):
+            raise ValueError("log_std_min and log_std_max must be finite with -20 <= log_std_min < log_std_max "
+                             f"<= 20, got {self.log_std_min} and {self.log_std_max}")
+        if self.target_entropy is not None and not np.isfinite(self.target_entropy):
+            raise ValueError(f"target_entropy must be finite (or None), got {self.target_entropy}")
         if not 0.0 < self.tau <= 1.0:
             raise ValueError(f"tau must be in (0, 1], got {self.tau}")
         if not 0.0 <= self.her_ratio <= 1.0:
@@ -150,7 +177,7 @@ class SACConfig:
         if not (np.isfinite(self.action_anchor) and self.action_anchor >= 0):
             raise ValueError(f"action_anchor must be a finite weight >= 0, got {self.action_anchor}")
         if self.min_replay_size > self.max_replay_size:
-            raise ValueError("min_replay_size exceeds max_replay_size")
+            raise ValueError(f"min_replay_size {self.min_replay_size} exceeds max_replay_size {self.max_replay_size}")
         object.__setattr__(self, "hidden_sizes", tuple(int(h) for h in self.hidden_sizes))
 
     @property
