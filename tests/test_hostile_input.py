@@ -1,0 +1,266 @@
+"""Every command as a hostile user drives it: bad flags, damaged files, two runs in one
+directory, Ctrl-C. The promise (README): exit 0 on success, 2 with one line
+`robostrich-X: error: ...` on bad input (no traceback), 130 on Ctrl-C with a checkpoint
+written (training) and nothing half-written (the others).
+
+Commands run as installed scripts, side by side where they are independent.
+"""
+import json
+import math
+import os
+import pathlib
+import shutil
+import signal
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+from agents import checkpoint
+from conftest import console_script
+
+ENVIRONMENT = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+
+TRAIN = ["--plan", "lesson1:300,lesson2:300", "--hidden", "16,16", "--batch-size", "16", "--min-replay", "50",
+         "--num-eval-targets", "1", "--final-eval-targets", "1", "--eval-every", "600", "--track-task", "",
+         "--quiet", "--no-rerun", "--no-figures"]
+
+
+@pytest.fixture(scope="module", autouse=True)
+def shared_jax_cache(tmp_path_factory):
+    """One persistent XLA cache for this module's processes: a resume reuses the first run's compilations."""
+    ENVIRONMENT.update(JAX_COMPILATION_CACHE_DIR=str(tmp_path_factory.mktemp("jax_cache")),
+                       JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS="0", JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES="0")
+
+
+def start(name, *args, cwd=None):
+    return subprocess.Popen([console_script(name), *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=ENVIRONMENT, cwd=cwd)
+
+
+def finish(process, timeout=600):
+    stdout, stderr = process.communicate(timeout=timeout)
+    return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
+
+
+def one_line_error(result, *fragments):
+    """Exit 2 and exactly one stderr line, `NAME: error: ...` holding every fragment."""
+    name = os.path.basename(result.args[0])
+    lines = result.stderr.strip().splitlines()
+    assert result.returncode == 2 and len(lines) == 1, (result.returncode, result.stderr[-3000:])
+    assert lines[0].startswith(f"{name}: error: "), lines[0]
+    for fragment in fragments:
+        assert fragment in lines[0], (fragment, lines[0])
+    return lines[0]
+
+
+def wait_for(condition, what, timeout=400):
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, f"timed out waiting for {what}"
+        time.sleep(0.2)
+
+
+def files(directory: pathlib.Path) -> dict:
+    return {p.relative_to(directory): p.read_bytes() for p in directory.rglob("*") if p.is_file()}
+
+
+FLAG_CASES = {  # (command, arguments, fragments the one line must hold)
+    "steps_0": ("robostrich-train", ["--steps", "0"], ["--steps"]),
+    "steps_negative": ("robostrich-train", ["--steps", "-100"], ["--steps"]),
+    "steps_huge": ("robostrich-train", ["--steps", "1e12"], ["--steps"]),
+    "plan_huge": ("robostrich-train", ["--plan", "lesson1:1e12"], ["--plan", "100000000"]),
+    "lr_negative": ("robostrich-train", ["--learning-rate", "-1"], ["--learning-rate"]),
+    "lr_nan": ("robostrich-train", ["--learning-rate", "nan"], ["--learning-rate", "nan"]),
+    "hidden_0": ("robostrich-train", ["--hidden", "0"], ["--hidden"]),
+    "hidden_negative": ("robostrich-train", ["--hidden", "-3"], ["--hidden"]),
+    "log_std": ("robostrich-train", ["--log-std-min", "5", "--log-std-max", "-5"], ["--log-std-min", "--log-std-max"]),
+    "temperature": ("robostrich-train", ["--init-temperature", "-1"], ["--init-temperature"]),
+    "lessons_empty": ("robostrich-train", ["--lessons", ","], ["--lessons"]),
+    "replay_huge": ("robostrich-train", ["--replay-size", "1000000000000"], ["--replay-size", "10000000"]),
+    "train_track_task": ("robostrich-train", ["--track-task", "nope"], ["--track-task", "nope"]),
+    "train_heldout_track": ("robostrich-train", ["--heldout-task", "track"], ["--heldout-task", "track"]),
+    "task_kwargs_far": ("robostrich-train", ["--task-kwargs", '{"target_pool": [[5, 0]]}'],
+                        ["--task-kwargs", "far outside any workspace"]),
+    "evaluate_targets_0": ("robostrich-evaluate", ["x.pkl", "--num-targets", "0"], ["--num-targets"]),
+    "evaluate_targets_negative": ("robostrich-evaluate", ["x.pkl", "--num-targets", "-3"], ["--num-targets"]),
+    "targets_nan": ("robostrich-targets", ["--seek-level-time", "nan", "--out", "t.npz"], ["--seek-level-time"]),
+    "movement_nan": ("robostrich-movement", ["--amplitude", "nan"], ["--amplitude"]),
+    "movement_inf": ("robostrich-movement", ["--ramp-time", "inf"], ["--ramp-time"]),
+    "walk_inf": ("robostrich-walk", ["--seconds", "inf"], ["--seconds"]),
+    "walk_long": ("robostrich-walk", ["--seconds", "1e6"], ["--seconds", "600"]),
+    "gait_slow": ("robostrich-gait", ["--frequency", "1e-9", "--out", "g.csv"], ["--frequency"]),
+    "workspace_settle": ("robostrich-workspace", ["--settle-time", "1e9"], ["--settle-time", "600"]),
+    "workspace_samples": ("robostrich-workspace", ["--samples", "1e15"], ["--samples"]),
+    "stabilize_far": ("robostrich-stabilize", ["--distance", "-5"], ["--distance"]),
+    "stabilize_seeds": ("robostrich-stabilize", ["--seeds", "1000000"], ["--seeds", "1000"]),
+    "gap_steps": ("robostrich-gap", ["--steps-per-target", "10000000000"], ["--steps-per-target"]),
+    "layouts_stiffness": ("robostrich-layouts", ["--stiffness", "inf"], ["--stiffness"]),
+}
+
+
+def test_bad_flags_exit_2_with_one_line_naming_the_flag(tmp_path):
+    """Nonsense is refused before anything runs, with a bound named for every count and duration."""
+    processes = {case: start(name, *args, cwd=tmp_path) for case, (name, args, _) in FLAG_CASES.items()}
+    for case, process in processes.items():
+        one_line_error(finish(process), *FLAG_CASES[case][2])
+    assert os.listdir(tmp_path) == []  # nothing written, not even a run directory
+
+
+def test_damaged_files_are_named_in_one_line(tmp_path):
+    wide = tmp_path / "wide.csv"
+    wide.write_text("time," + "x" * 200_000 + "\n")  # a field over csv's 128 KB limit
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100_000 + "]" * 100_000)
+    latin = tmp_path / "latin.json"
+    latin.write_bytes('{"name": "caf\u00e9"}'.encode("latin-1"))
+    keys = tmp_path / "keys.npz"
+    np.savez(keys, positions=np.zeros((3, 2)))
+    whole = tmp_path / "whole.npz"
+    np.savez(whole, head_position=np.zeros((3, 2)), head_attitude=np.zeros(3), control=np.zeros((3, 9)),
+             fingerprint=np.array("x"))
+    truncated = tmp_path / "truncated.npz"
+    truncated.write_bytes(whole.read_bytes()[:200])
+    cases = {
+        "gait_field": (start("robostrich-stabilize", "--gait", wide, "--out", tmp_path / "s"), ["wide.csv", "line 1"]),
+        "layout_deep": (start("robostrich-layouts", "--layout-file", deep, "--out", tmp_path / "l1"),
+                        ["deep.json", "nested too deeply"]),
+        "layout_latin": (start("robostrich-layouts", "--layout-file", latin, "--out", tmp_path / "l2"),
+                         ["latin.json", "UTF-8"]),
+        "npz_keys": (start("robostrich-targets", "--recheck", "--out", keys), ["keys.npz", "head_position"]),
+        "npz_truncated": (start("robostrich-targets", "--recheck", "--out", truncated), ["truncated.npz"]),
+        "npz_append": (start("robostrich-targets", "--append", "--samples", "1", "--seek-level-time", "0",
+                             "--workers", "1", "--out", keys), ["keys.npz", "fingerprint"]),
+    }
+    for case, (process, fragments) in cases.items():
+        one_line_error(finish(process), *fragments)
+    assert np.load(keys).files == ["positions"]  # --append left the foreign file alone
+    assert not any((tmp_path / d).exists() for d in ("s", "l1", "l2"))
+
+
+def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
+    """Two workers (the default): a second run in the same --out is refused while the first holds
+    it; Ctrl-C checkpoints both runs and exits 130; --resume drops a torn last metrics line and
+    finishes with a metrics line for every step, episodes cut by a lesson's end included."""
+    out = tmp_path / "run"
+    first = start("robostrich-train", *TRAIN, "--out", out)
+    wait_for(lambda: (out / ".lock").exists() and (out / ".lock").read_text().strip(), "the run's lock")
+    second = finish(start("robostrich-train", *TRAIN, "--seed", "1", "--out", out))
+    one_line_error(second, str(out), "in use")
+    wait_for(lambda: (out / "curriculum" / "metrics.jsonl").exists() and first.poll() is None
+             and (out / "curriculum" / "metrics.jsonl").stat().st_size > 0, "the first episode")
+    first.send_signal(signal.SIGINT)
+    interrupted = finish(first)
+    assert interrupted.returncode == 130, interrupted.stderr[-3000:]
+    assert interrupted.stderr.strip().splitlines()[-1].startswith("robostrich-train: interrupted"), interrupted.stderr
+    assert "Traceback" not in interrupted.stderr, interrupted.stderr[-3000:]
+    assert json.loads((out / "config.json").read_text())["seed"] == 0  # the second run touched nothing
+    steps = {}
+    for label in ("curriculum", "baseline"):
+        record = checkpoint._read_record(str(out / label / "checkpoint.pkl"))
+        steps[label] = record["payload"]["loop"]["env_steps"]
+        assert 0 < steps[label] <= 600, steps
+    assert steps["curriculum"] < 600 or steps["baseline"] < 600  # stopped early, not at the plan's end
+
+    missing = tmp_path / "missing"  # checkpoints with a valid checksum but no learner: a worker's one line
+    shutil.copytree(out, missing)
+    for label in ("curriculum", "baseline"):
+        path = missing / label / "checkpoint.pkl"
+        record = checkpoint._read_record(str(path))
+        checkpoint.save(str(path), {k: v for k, v in record["payload"].items() if k != "learner"},
+                        record["fingerprint"])
+    rejected = start("robostrich-train", *TRAIN, "--out", missing, "--resume")
+    torn = out / "curriculum" / "metrics.jsonl"
+    with open(torn, "a") as f:
+        f.write('{"env_steps": 599, "return": -3')  # a crash in mid-write
+    resumed = finish(start("robostrich-train", *TRAIN, "--no-baseline", "--out", out, "--resume"))
+    assert resumed.returncode == 0, resumed.stderr[-3000:]
+    records = [json.loads(line) for line in torn.read_text().splitlines()]
+    assert sum(r["length"] for r in records) == 600 and records[-1]["env_steps"] == 600, records
+    assert [r["env_steps"] for r in records if r.get("cut")] == [300, 600]  # lesson 1's last episode, cut
+    one_line_error(finish(rejected), "checkpoint.pkl", "learner")
+
+
+def test_incomplete_checkpoints_and_task_names_are_refused_before_any_work(tmp_path):
+    from agents.sac.config import SACConfig
+    fingerprint = {"plan": "robostrich/lesson1:300,robostrich/lesson2:300", "config": SACConfig().to_dict(),
+                   "seed": 0, "observation_layout": [], "action_size": 9}
+    empty, whole = tmp_path / "empty.pkl", tmp_path / "whole.pkl"
+    checkpoint.save(str(empty), {}, fingerprint)
+    checkpoint.save(str(whole), {k: None for k in ("learner", "actor_key", "replay", "loop", "lesson_index",
+                                                   "lesson_steps", "environment")}, fingerprint)
+    checkpoint.save(str(tmp_path / "no_plan.pkl"), {}, {"seed": 0})
+    cases = {
+        "evaluate": (start("robostrich-evaluate", empty, "--out", tmp_path / "e"), ["empty.pkl", "learner"]),
+        "no_plan": (start("robostrich-evaluate", tmp_path / "no_plan.pkl", "--out", tmp_path / "e"),
+                    ["no_plan.pkl", "plan"]),
+        "init_from": (start("robostrich-train", *TRAIN, "--init-from", empty, "--out", tmp_path / "i"),
+                      ["--init-from", "learner"]),
+        "track": (start("robostrich-evaluate", whole, "--track-task", "nope", "--out", tmp_path / "e"),
+                  ["--track-task", "nope"]),
+        "heldout": (start("robostrich-evaluate", whole, "--heldout-task", "track", "--out", tmp_path / "e"),
+                    ["--heldout-task", "track"]),
+    }
+    for case, (process, fragments) in cases.items():
+        one_line_error(finish(process), *fragments)
+    assert not (tmp_path / "e").exists() and not (tmp_path / "i").exists()
+
+
+def test_torn_and_damaged_metrics_lines(tmp_path):
+    """A torn last line is what a crash leaves (dropped); a bad line before it is named, file and line."""
+    from agents.curriculum import read_records
+    path = tmp_path / "metrics.jsonl"
+    path.write_text('{"env_steps": 1}\n{"env_steps": 2, "ret')
+    assert read_records(str(path)) == [{"env_steps": 1}]
+    path.write_text('{"env_steps": 1}\n{"env_ste\n{"env_steps": 3}\n')
+    with pytest.raises(ValueError, match=r"metrics.jsonl: line 2"):
+        read_records(str(path))
+
+
+def test_ctrl_c_stops_a_long_command_with_130_and_nothing_half_written(tmp_path):
+    out = tmp_path / "stabilize"
+    process = start("robostrich-stabilize", "--seeds", "200", "--no-progress", "--no-rerun", "--no-figures",
+                    "--out", out)
+    wait_for(lambda: out.exists() or process.poll() is not None, "the first rollout")
+    time.sleep(1.0)
+    process.send_signal(signal.SIGINT)
+    result = finish(process)
+    assert result.returncode == 130, result.stderr[-3000:]
+    assert result.stderr.strip().splitlines() == ["robostrich-stabilize: interrupted"], result.stderr
+    assert os.listdir(out) == []  # no report, no half-written file
+
+
+def test_config_fields_are_checked_where_they_are_owned():
+    from agents.sac.config import SACConfig
+    for bad in ({"learning_rate": math.nan}, {"hidden_sizes": ()}, {"batch_size": 0}, {"reward_scale": math.inf},
+                {"log_std_min": 2.0, "log_std_max": 2.0}, {"max_replay_size": 10**12}, {"target_entropy": math.nan}):
+        field = next(iter(bad))
+        with pytest.raises(ValueError, match=field):
+            SACConfig(**bad)
+    assert SACConfig.paper_sac().hidden_sizes == (256, 256)  # the presets still pass
+
+
+def test_task_options_are_checked_in_their_constructors():
+    import robostrich_suite
+    from robostrich_suite.tasks.randomization import DomainRandomization
+    with pytest.raises(ValueError, match="joint_angle_noise"):
+        DomainRandomization(joint_angle_noise=math.nan)
+    with pytest.raises(ValueError, match="mass_scale"):
+        DomainRandomization(mass_scale=(0.9, math.inf))
+    for kwargs, match in (({"target_axes": (0, 5)}, "target_axes"), ({"target_axes": (0, 0)}, "target_axes"),
+                          ({"target_pool": [[0.2, 0.3], [0.0, -5.0]]}, "far outside any workspace")):
+        with pytest.raises(ValueError, match=match):
+            robostrich_suite.load("robostrich", "lesson2", task_kwargs=kwargs)
+
+
+def test_gym_adapter_falls_back_to_the_free_camera():
+    pytest.importorskip("gymnasium")
+    from robostrich_suite import gym_adapter
+    named = gym_adapter.make("robostrich", "lesson2", render_mode="rgb_array", width=32, height=24)
+    unknown = gym_adapter.make("robostrich", "lesson2", render_mode="rgb_array", width=32, height=24, camera="nope")
+    for env in (named, unknown):
+        env.reset(seed=0)
+    frame = unknown.render()
+    assert frame.shape == (24, 32, 3) and frame.dtype == np.uint8 and frame.any()
+    assert not np.array_equal(frame, named.render())  # another view: the free camera, not the side one
