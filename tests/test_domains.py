@@ -111,7 +111,7 @@ def test_default_lessons_are_the_domains_curriculum():
     parse = training.build_parser().parse_args
     frame = training.plan_from_args(parse(["--steps", "300"]))
     assert [(l.domain, l.task, l.steps) for l in frame] == [
-        ("robostrich", "lesson1", 100), ("robostrich", "lesson2", 100), ("robostrich", "lesson3", 100)]
+        ("robostrich", "lesson1", 80), ("robostrich", "lesson2", 80), ("robostrich", "lesson3", 140)]  # 4:4:7
     quadruped = training.plan_from_args(parse(["--domain", "robostrich_a1", "--steps", "1000"]))
     assert [l.task for l in quadruped] == ["lesson1", "lesson2", "lesson3", "lesson4"]
     assert sum(l.steps for l in quadruped) == 1000

@@ -232,8 +232,10 @@ def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
     config = training.config_from_args(args, ["--paper-sac", "--batch-size", "32"])
     assert config == SACConfig.paper_sac(batch_size=32)
     assert not config.critic_layer_norm and config.her_ratio == 0 and config.init_temperature == 1.0
-    default = training.config_from_args(training.build_parser().parse_args([]), [])
-    assert default == SACConfig()  # the CLI's defaults are the dataclass's
+    default = training.config_from_args(training.build_parser().parse_args(["--domain", "reacher"]), [])
+    assert default == SACConfig()  # the CLI's defaults are the dataclass's, under the main job's on robostrich
+    arm = training.config_from_args(training.build_parser().parse_args([]), [])
+    assert arm == SACConfig(**training.MAIN_JOB_CONFIG["robostrich"])
     argv = ["--her-ratio", "0.5", "--her-lessons", "lesson1,lesson2", "--hidden", "32,16"]
     config = training.config_from_args(training.build_parser().parse_args(argv), argv)
     assert config.her_lessons == ("lesson1", "lesson2") and config.hidden_sizes == (32, 16)
@@ -290,6 +292,26 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     assert training.resolve_task_kwargs({}, dmc) == {}
     with pytest.raises(ValueError, match="target_entropy_per_action"):
         SACConfig(target_entropy_per_action=float("nan"))
+
+
+def test_main_job_on_the_arm_gives_lesson_3_the_longest_share_and_narrower_noise():
+    """On robostrich the main job's curriculum is 160k / 160k / 280k control steps with lesson 3's
+    target entropy at -3 per tendon; a flag given wins, --paper-sac and other domains keep theirs."""
+    def made(*argv):
+        args = training.build_parser().parse_args(list(argv))
+        return training.format_plan(training.plan_from_args(args)), training.config_from_args(args, list(argv))
+
+    plan, config = made()
+    assert plan == "robostrich/lesson1:160000,robostrich/lesson2:160000,robostrich/lesson3:280000"
+    assert config.target_entropy_in_lesson("lesson3", 9) == -27.0
+    assert config.target_entropy_in_lesson("lesson1", 9) == config.target_entropy_in_lesson("lesson2", 9) == -18.0
+    assert made("--steps", "1500")[0] == "robostrich/lesson1:400,robostrich/lesson2:400,robostrich/lesson3:700"
+    assert made("--lessons", "lesson1,lesson3", "--steps", "1000")[0] == "robostrich/lesson1:500,robostrich/lesson3:500"
+    assert made("--exploration-target-entropy-per-action", "-2.5")[1].target_entropy_in_lesson("lesson3", 9) == -22.5
+    assert made("--exploration-lessons", "")[1].exploration_lessons == ()
+    assert made("--paper-sac")[1].exploration_lessons == ()
+    plan, config = made("--domain", "robostrich_a1")
+    assert plan.count(":120000") == 4 and config.exploration_lessons == ()
 
 
 def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resume(tmp_path):

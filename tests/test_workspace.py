@@ -171,12 +171,12 @@ def test_targets_are_generated_from_the_workspace_sampler(tmp_path, physics):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["--samples", "-5"], "argument --samples: must be at least 0, got -5"),
+    (["--samples", "-5"], "argument --samples: must be from 0 to 10000000, got -5"),
     (["--samples", "0", "--edge-samples", "0"], "no kinematic workspace"),
-    (["--settle-time", "nan"], "argument --settle-time: must be a finite number of seconds > 0"),
-    (["--settle-time", "0"], "argument --settle-time: must be a finite number of seconds > 0"),
-    (["--seek-level", "-1"], "argument --seek-level: must be a finite number of seconds >= 0"),
-    (["--workers", "0"], "argument --workers: must be at least 1, got 0"),
+    (["--settle-time", "nan"], "argument --settle-time: must be a number of seconds > 0 and at most 600, got nan"),
+    (["--settle-time", "0"], "argument --settle-time: must be a number of seconds > 0 and at most 600, got 0"),
+    (["--seek-level", "-1"], "argument --seek-level: must be a number of seconds >= 0 and at most 600, got -1"),
+    (["--workers", "0"], "argument --workers: must be from 1 to 256, got 0"),
     (["--actuated-samples", "2.5"], "argument --actuated-samples: invalid whole number: '2.5'"),
 ])
 def test_command_line_refuses_bad_numbers_by_flag(tmp_path, capsys, args, message):

@@ -63,8 +63,9 @@ class SACConfig:
     long_horizon_lessons: Tuple[str, ...] = ()
     long_horizon_discount: float = 0.995
     # Lessons that train toward `exploration_target_entropy_per_action` x |A| instead of the
-    # target entropy above (empty: none). Lesson 3's moves between targets can need a manoeuvre
-    # (uncurling the neck through a whole turn) that the policy's narrow noise never tries.
+    # target entropy above (empty: none): wider noise for a manoeuvre the policy's narrow noise
+    # never tries (uncurling the neck through a whole turn), or narrower noise where precision
+    # matters more than search (the main job's lesson 3 on robostrich: agents/training.py).
     exploration_lessons: Tuple[str, ...] = ()
     exploration_target_entropy_per_action: float = -1.0
     # ... and explore there with noise correlated over control steps (AR(1) coefficient per step
