@@ -1,6 +1,7 @@
 """Shared test set-up: headless MuJoCo (MUJOCO_GL=egl unless the environment sets it), the
 checked-in models, one way to find an installed console script (``from conftest import
-console_script``) and one way to check Rerun recordings."""
+console_script``), one way to run it as a user would (``start`` / ``finish``, sharing one XLA
+cache per module with the ``shared_jax_cache`` fixture) and one way to check Rerun recordings."""
 import os
 import pathlib
 import shutil
@@ -52,3 +53,27 @@ def verify_rrd():
                                     timeout=300)
             assert result.returncode == 0, f"{path}: {result.stderr[-2000:]}"
     return verify
+
+
+# The environment installed commands run in: headless, and (with ``shared_jax_cache``) one
+# persistent XLA cache per test module, so a later process reuses an earlier one's compilations.
+COMMAND_ENVIRONMENT = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+
+
+@pytest.fixture(scope="module")
+def shared_jax_cache(tmp_path_factory):
+    """Commands this module starts share one persistent XLA cache (evaluate reuses train's compilations)."""
+    COMMAND_ENVIRONMENT.update(JAX_COMPILATION_CACHE_DIR=str(tmp_path_factory.mktemp("jax_cache")),
+                               JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS="0",
+                               JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES="0")
+
+
+def start(name, *args, cwd=None) -> subprocess.Popen:
+    """The installed command ``name`` started with ``args``, its output captured."""
+    return subprocess.Popen([console_script(name), *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=COMMAND_ENVIRONMENT, cwd=cwd)
+
+
+def finish(process, timeout=600) -> subprocess.CompletedProcess:
+    stdout, stderr = process.communicate(timeout=timeout)
+    return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)

@@ -16,31 +16,14 @@ from agents import checkpoint
 from robostrich_suite import targets
 from robostrich_suite.model import layouts
 
-from conftest import console_script
+from conftest import finish, start
 
 TINY_TRAIN = ["--plan", "lesson1:250", "--no-baseline", "--hidden", "16,16", "--batch-size", "16",
               "--min-replay", "50", "--num-eval-targets", "1", "--final-eval-targets", "1", "--quiet",
               "--no-rerun", "--no-figures"]
 
 
-ENVIRONMENT = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
-
-
-@pytest.fixture(scope="module", autouse=True)
-def shared_jax_cache(tmp_path_factory):
-    """One persistent XLA cache for this module's processes: evaluate reuses train's compilations (~6 s)."""
-    ENVIRONMENT.update(JAX_COMPILATION_CACHE_DIR=str(tmp_path_factory.mktemp("jax_cache")),
-                       JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS="0", JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES="0")
-
-
-def start(name, *args, cwd=None):
-    return subprocess.Popen([console_script(name), *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=ENVIRONMENT, cwd=cwd)
-
-
-def finish(process, timeout=300):
-    stdout, stderr = process.communicate(timeout=timeout)
-    return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
+pytestmark = pytest.mark.usefixtures("shared_jax_cache")
 
 
 def call(name, *args, cwd=None):

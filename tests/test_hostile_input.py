@@ -11,37 +11,19 @@ import os
 import pathlib
 import shutil
 import signal
-import subprocess
 import time
 
 import numpy as np
 import pytest
 
 from agents import checkpoint
-from conftest import console_script
+from conftest import finish, start
 
-ENVIRONMENT = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+pytestmark = pytest.mark.usefixtures("shared_jax_cache")
 
 TRAIN = ["--plan", "lesson1:300,lesson2:300", "--hidden", "16,16", "--batch-size", "16", "--min-replay", "50",
          "--num-eval-targets", "1", "--final-eval-targets", "1", "--eval-every", "600", "--track-task", "",
          "--quiet", "--no-rerun", "--no-figures"]
-
-
-@pytest.fixture(scope="module", autouse=True)
-def shared_jax_cache(tmp_path_factory):
-    """One persistent XLA cache for this module's processes: a resume reuses the first run's compilations."""
-    ENVIRONMENT.update(JAX_COMPILATION_CACHE_DIR=str(tmp_path_factory.mktemp("jax_cache")),
-                       JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS="0", JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES="0")
-
-
-def start(name, *args, cwd=None):
-    return subprocess.Popen([console_script(name), *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=ENVIRONMENT, cwd=cwd)
-
-
-def finish(process, timeout=600):
-    stdout, stderr = process.communicate(timeout=timeout)
-    return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
 
 
 def one_line_error(result, *fragments):
