@@ -321,8 +321,6 @@ def plan_from_args(args):
         if not tasks:
             raise ValueError(f"--lessons {args.lessons!r} names no task, e.g. --lessons lesson1,lesson2")
     total = args.steps if args.steps is not None else MAIN_JOB_STEPS.get(args.domain, DEFAULT_TOTAL_STEPS)
-    if total < len(tasks):
-        raise ValueError(f"--steps {total} leaves a lesson without a step ({len(tasks)} lessons)")
     shares = MAIN_JOB_LESSON_SHARES.get(args.domain) if args.lessons is None else None
     shares = shares or (1,) * len(tasks)
     steps = [total * share // sum(shares) for share in shares[:-1]]
