@@ -141,13 +141,15 @@ class ReplayBuffer:
         return Transitions(obs, action, reward, discount, next_obs)
 
     def state_dict(self) -> dict:
-        """The filled part only, plus the insertion point and sampling RNG, for exact resumption."""
+        """The filled part only, plus the insertion point and sampling RNG, for exact resumption.
+        The arrays are views of the buffer (a checkpoint pickles them at once; a copy of a full
+        replay costs as much as writing it): copy them to keep them while the replay moves on."""
         n = self.size
         return {"capacity": self.capacity, "obs_size": self.obs_size, "action_size": self.action_size,
                 "goal_width": self.goal_width, "repeat": self.repeat,
                 "size": n, "insert_index": self.insert_index, "rng": self.rng.bit_generator.state,
                 "total_added": self.total_added, "episode_start": self.episode_start,
-                **{f: getattr(self, f)[:n].copy() for f in self.fields}}
+                **{f: getattr(self, f)[:n] for f in self.fields}}
 
     def load_state_dict(self, d: dict):
         for k in ("capacity", "obs_size", "action_size", "goal_width", "repeat"):

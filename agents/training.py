@@ -28,6 +28,7 @@ from agents import evaluation
 from agents.curriculum import (CurriculumRun, Lesson, check_lesson_names, format_plan, parse_plan, read_records,
                                run_files, run_identity, upgrade_fingerprint)
 from agents.domains import Domain
+from agents.lookup import LABEL as LOOKUP_LABEL
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from robostrich_suite import cli as cli_lib
@@ -419,6 +420,19 @@ class RunSpec:
         return run
 
 
+@dataclasses.dataclass(frozen=True)
+class LookupSpec:
+    """The no-learning lookup's final evaluation as a job of its own: in a parallel job it takes the
+    core the first finished run frees instead of running alone after both."""
+
+    label: str = LOOKUP_LABEL
+    total_steps: int = 0
+
+    def evaluate(self, job: RunJob) -> Optional[dict]:
+        return evaluation.evaluate_lookup(job.out_eval, job.domain, job.heldout_task, job.track_task,
+                                          job.final_eval_targets, record=job.record)
+
+
 def train_and_evaluate(run: CurriculumRun, job: RunJob, progress=None) -> dict:
     """Finish `run`'s plan (periodic held-out evaluations in its evals.jsonl), then its final
     evaluation (JSON reports in job.out_eval). Returns the reports and the run's counters."""
@@ -472,9 +486,13 @@ def _worker(spec: RunSpec, job, queue):
     label = spec.label
     signal.signal(signal.SIGINT, signal.default_int_handler)  # the parent started it ignored
     try:
-        run = spec.build(restore=True)
-        queue.put(("steps", label, (run.loop.env_steps, lesson_text(run))))  # where a resumed run starts
-        outcome = train_and_evaluate(run, job, _QueueProgress(queue, label))
+        if isinstance(spec, LookupSpec):
+            spec.evaluate(job)
+            outcome = {}
+        else:
+            run = spec.build(restore=True)
+            queue.put(("steps", label, (run.loop.env_steps, lesson_text(run))))  # where a resumed run starts
+            outcome = train_and_evaluate(run, job, _QueueProgress(queue, label))
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # done: a late request to stop changes nothing
         queue.put(("done", label, {k: v for k, v in outcome.items() if k != "reports"}))
     except KeyboardInterrupt as error:
@@ -652,15 +670,16 @@ def main(argv=None):
     progress = Progress(sum(spec.total_steps for spec in specs.values()), enabled=not args.quiet)
     progress.bar and progress.bar.update(sum(r.loop.env_steps for r in runs.values()))
     try:
-        if parallel:
-            outcomes = _train_in_parallel(specs, job, progress, workers)
+        if parallel:  # the lookup's evaluation joins the workers' queue (a run's core once it is done)
+            jobs = {**specs, LOOKUP_LABEL: LookupSpec()} if domain.is_arm else specs
+            outcomes = _train_in_parallel(jobs, job, progress, workers)
+            lookup = outcomes.pop(LOOKUP_LABEL)["reports"] if domain.is_arm else None
         else:
             outcomes = {label: train_and_evaluate(run, job, progress) for label, run in runs.items()}
+            lookup = LookupSpec().evaluate(job)
     finally:
         progress.close()
     finals = {label: o["reports"] for label, o in outcomes.items()}
-    lookup = evaluation.evaluate_lookup(out_eval, domain, heldout_task, track_task, args.final_eval_targets,
-                                        record=not args.no_rerun)
     if lookup is not None:  # the no-learning bar, beside the agents
         finals["lookup"] = lookup
     # written by whoever trained, here or in a worker
