@@ -1,0 +1,186 @@
+"""The results page and the README's results table, generated from committed result records.
+
+    python tools/results_page.py add main_job runs/seeds_main/seeds.json \\
+        --title "The main job on the paper's robot" --command "python tools/benchmark_seeds.py --seeds 0,1,2,3"
+    python tools/results_page.py            # rewrite docs/results.md and the README's table
+    python tools/results_page.py --check    # exit 1 when either differs from the records
+
+A record (docs/results/NAME.json) keeps what a benchmark wrote (tools/benchmark_seeds.py's
+seeds.json), the command that made it, the date and the machine. Numbers are typed nowhere else:
+the page and the README's table are rendered from the records, and tests/test_results_page.py
+fails when the committed text differs from what the records give.
+"""
+import argparse
+import datetime
+import json
+import os
+import pathlib
+import platform
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+RECORDS = ROOT / "docs" / "results"
+PAGE = ROOT / "docs" / "results.md"
+README = ROOT / "README.md"
+FORMAT = 1
+README_BEGIN, README_END = "<!-- results: main_job (tools/results_page.py writes this table) -->", "<!-- /results -->"
+README_RECORD = "main_job"
+
+RUNS = {"curriculum": "curriculum SAC", "baseline": "plain SAC (final lesson only)", "lookup": "lookup (no learning)"}
+KINDS = {"heldout": "held-out, fixed start", "heldout_moving": "held-out, moving starts",
+         "track": "`track` (3 targets in turn)"}
+
+
+def machine() -> str:
+    """Cores and CPU model: timings mean something only beside them."""
+    model = platform.processor() or "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            model = next((line.split(":", 1)[1].strip() for line in f if line.startswith("model name")), model)
+    except OSError:
+        pass
+    return f"{os.cpu_count()} cores, {model}"
+
+
+def make_record(name: str, seeds_json: str, title: str, command: str, date: str = None, note: str = "") -> dict:
+    with open(seeds_json) as f:
+        aggregate = json.load(f)
+    if "results" not in aggregate or "seeds" not in aggregate:
+        raise ValueError(f"{seeds_json} is not a tools/benchmark_seeds.py seeds.json (no 'results'/'seeds')")
+    return {"format": FORMAT, "name": name, "title": title, "command": command,
+            "date": date or datetime.date.today().isoformat(), "machine": machine(), "note": note,
+            "seeds": aggregate}
+
+
+def read_records(directory: pathlib.Path = RECORDS) -> list:
+    records = []
+    for path in sorted(directory.glob("*.json")):
+        with open(path) as f:
+            record = json.load(f)
+        if record.get("format") != FORMAT:
+            raise ValueError(f"{path} has record format {record.get('format')}, this tool reads {FORMAT}")
+        records.append(record)
+    return sorted(records, key=lambda r: (r.get("order", 100), r["name"]))
+
+
+def _cell(stats: dict, scale: float, unit: str, digits: int = 1) -> str:
+    if stats["mean"] is None:
+        return "-"
+    mean, low, high = (f"{stats[k] * scale:.{digits}f}" for k in ("mean", "min", "max"))
+    return f"{mean} {unit}" if low == high else f"{mean} {unit} [{low}, {high}]"
+
+
+def seeds_table(record: dict) -> list:
+    """Markdown rows: every run and evaluation, mean [min, max] over the seeds."""
+    lines = ["| run | evaluation | success | within 1 cm and 2 deg | median position error | median attitude error |",
+             "|---|---|---|---|---|---|"]
+    for label, kinds in record["seeds"]["results"].items():
+        for kind, row in kinds.items():
+            lines.append(f"| {RUNS.get(label, label)} | {KINDS.get(kind, kind)} | "
+                         f"{_cell(row['success_rate'], 100, '%')} | {_cell(row['precise_success_rate'], 100, '%')} | "
+                         f"{_cell(row['position_error_median'], 100, 'cm', 2)} | "
+                         f"{_cell(row['attitude_error_median'], 1, 'deg', 2)} |")
+    return lines
+
+
+def per_seed(record: dict) -> str:
+    """Each seed's fixed-start and moving-start success and `track` targets reached (of 3)."""
+    agg = record["seeds"]
+    curriculum = agg["results"].get("curriculum", {})
+    parts = []
+    for i, seed in enumerate(agg["seeds"]):
+        cells = []
+        for kind in ("heldout", "heldout_moving"):
+            values = curriculum.get(kind, {}).get("success_rate", {}).get("values", [])
+            cells.append(f"{values[i] * 100:.1f} %" if i < len(values) else "-")
+        track = curriculum.get("track", {}).get("success_rate", {}).get("values", [])
+        cells.append(f"{round(track[i] * 3)} of 3 track targets" if i < len(track) else "-")
+        minutes = agg["minutes"][i]
+        cells.append(f"{minutes:.1f} min" if minutes is not None else "time unknown")
+        parts.append(f"seed {seed}: " + " / ".join(cells))
+    return "; ".join(parts)
+
+
+def render_record(record: dict) -> str:
+    agg = record["seeds"]
+    steps = ", ".join(f"{RUNS.get(label, label)} {'/'.join(str(v) for v in sorted(set(filter(None, values))))}"
+                      for label, values in agg["steps"].items() if any(values))
+    lines = [f"## {record['title']}", "", f"`{record['command']}` ({record['date']}, {record['machine']}); "
+             f"mean [min, max] over seeds {', '.join(map(str, agg['seeds']))}; control steps per run: {steps}."]
+    if record.get("note"):
+        lines += ["", record["note"]]
+    lines += [""] + seeds_table(record) + ["", "Curriculum SAC per seed (held-out fixed / moving / `track` / "
+                                               "wall-clock of the whole job): " + per_seed(record) + "."]
+    return "\n".join(lines) + "\n"
+
+
+def render_page(records: list) -> str:
+    head = ("# Results\n\nGenerated by `python tools/results_page.py` from the records in `docs/results/` (what "
+            "the benchmarks wrote, with their command, date and machine); do not edit by hand. Success is the "
+            "paper's: the head within 5 cm and 5 deg of level at the episode's end. How these numbers were "
+            "reached, and what did not help: [learning.md](learning.md).\n")
+    return "\n".join([head] + [render_record(r) for r in records])
+
+
+def render_readme_table(record: dict) -> str:
+    lines = [README_BEGIN,
+             f"`{record['command']}` ({record['date']}, {record['machine']}), mean [min, max] over seeds "
+             f"{', '.join(map(str, record['seeds']['seeds']))}:", ""]
+    lines += seeds_table(record)
+    lines += ["", README_END]
+    return "\n".join(lines)
+
+
+def replace_readme_table(text: str, table: str) -> str:
+    begin, end = text.find(README_BEGIN), text.find(README_END)
+    if begin < 0 or end < begin:
+        raise ValueError(f"README.md has no '{README_BEGIN}' ... '{README_END}' block")
+    return text[:begin] + table + text[end + len(README_END):]
+
+
+def expected_files(records: list, readme_text: str) -> dict:
+    by_name = {r["name"]: r for r in records}
+    if README_RECORD not in by_name:
+        raise ValueError(f"no record {README_RECORD!r} in {RECORDS} for the README's table")
+    return {PAGE: render_page(records), README: replace_readme_table(readme_text, render_readme_table(by_name[README_RECORD]))}
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command")
+    add = sub.add_parser("add", help="store a benchmark's seeds.json as a record in docs/results/")
+    add.add_argument("name")
+    add.add_argument("seeds_json")
+    add.add_argument("--title", required=True)
+    add.add_argument("--command", dest="run_command", required=True, help="the command that produced it")
+    add.add_argument("--date", default=None, help="YYYY-MM-DD (default today)")
+    add.add_argument("--note", default="", help="one paragraph shown under the title")
+    add.add_argument("--order", type=int, default=100, help="position on the page (lower first)")
+    p.add_argument("--check", action="store_true", help="exit 1 when the page or the README differs from the records")
+    args = p.parse_args(argv)
+    if args.command == "add":
+        record = make_record(args.name, args.seeds_json, args.title, args.run_command, args.date, args.note)
+        record["order"] = args.order
+        RECORDS.mkdir(parents=True, exist_ok=True)
+        (RECORDS / f"{args.name}.json").write_text(json.dumps(record, indent=1) + "\n")
+        print(f"wrote {RECORDS / (args.name + '.json')}")
+        return 0
+    expected = expected_files(read_records(), README.read_text())
+    stale = [path for path, text in expected.items() if not path.exists() or path.read_text() != text]
+    if args.check:
+        for path in stale:
+            print(f"{path.relative_to(ROOT)} differs from docs/results/*.json: run python tools/results_page.py",
+                  file=sys.stderr)
+        return 1 if stale else 0
+    for path in stale:
+        path.write_text(expected[path])
+        print(f"wrote {path.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main())
+    except (ValueError, OSError) as error:
+        print(f"results_page: error: {error}", file=sys.stderr)
+        sys.exit(2)
