@@ -32,8 +32,8 @@ setup(
     },
     entry_points={
         "console_scripts": [
-            "robostrich-train = agents.training:cli",
-            "robostrich-evaluate = agents.evaluation:cli",
+            "robostrich-train = agents.robostrich.training:cli",
+            "robostrich-evaluate = agents.robostrich.evaluation:cli",
             "robostrich-walk = robostrich_suite.studies.walk:cli",
             "robostrich-export-xml = robostrich_suite.xml_export:cli",
             "robostrich-movement = robostrich_suite.studies.movement:cli",
@@ -41,9 +41,9 @@ setup(
             "robostrich-layouts = robostrich_suite.studies.layout_compare:cli",
             "robostrich-targets = robostrich_suite.studies.target_generation:cli",
             "robostrich-gait = robostrich_suite.studies.gait_generation:cli",
-            "robostrich-stabilize = agents.application_commands:stabilize_cli",
-            "robostrich-gap = agents.application_commands:gap_cli",
-            "robostrich-play = agents.play:cli",
+            "robostrich-stabilize = agents.robostrich.application_commands:stabilize_cli",
+            "robostrich-gap = agents.robostrich.application_commands:gap_cli",
+            "robostrich-play = agents.robostrich.play:cli",
         ],
     },
 )

@@ -1,7 +1,7 @@
 """A generic actor: flattened observation in, environment action out.
 
 The policy network works in [-1, 1]^|A|; `ActionAdapter` maps that box onto
-the BoundedArray spec (e.g. tendon contractions in metres) and back.
+the BoundedArray spec (e.g. actuator inputs in their own units) and back.
 """
 import jax
 import jax.numpy as jnp
@@ -36,11 +36,10 @@ class ActionAdapter:
 class ResidualAdapter(ActionAdapter):
     """The policy corrects a base controller: env action = base(obs) + scale x half-range x a, clipped.
 
-    Residual RL (Johannink et al. 2019, Silver et al. 2018): the base policy here is the lookup
-    baseline (agents/lookup.py), whose stored inputs bring the head near the target from the
-    straight start but cannot use feedback. The policy only learns the correction, within
-    ``scale`` (a fraction of each tendon's half-range) of the base; a zero policy output is the
-    base itself. Hindsight goal relabelling does not mix with it (a new goal changes the base
+    Residual RL (Johannink et al. 2019, Silver et al. 2018): the base is a controller that gets
+    near the goal without feedback (a table of stored actions, say). The policy only learns the
+    correction, within ``scale`` (a fraction of each action dimension's half-range) of the base;
+    a zero policy output is the base itself. Hindsight goal relabelling does not mix with it (a new goal changes the base
     action, so the stored residual no longer means what it did).
     """
 

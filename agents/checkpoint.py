@@ -11,7 +11,9 @@ import pickle
 import tempfile
 
 MAGIC = b"RSACKPT1"
-FORMAT_VERSION = 1
+# The payload's layout; a checkpoint of another version is refused (version 2: the run state
+# holds every field a resume reads, the fingerprint no field a reader must fill in).
+FORMAT_VERSION = 2
 
 
 class CheckpointError(ValueError):
@@ -47,11 +49,11 @@ def _read_record(path: str) -> dict:
 
 def read_with_digest(path: str) -> tuple:
     """(record, hex sha256 of its payload) after the checks of :func:`_read_record`: the digest names
-    this checkpoint's content (``robostrich-train --init-from`` records it)."""
+    this checkpoint's content (a run started from it records it)."""
     with open(path, "rb") as f:
         data = f.read()
     if len(data) < len(MAGIC) + 32 or data[:len(MAGIC)] != MAGIC:
-        raise CheckpointError(f"{path} is not a robostrich SAC checkpoint (bad header or truncated)")
+        raise CheckpointError(f"{path} is not a SAC checkpoint of this package (bad header or truncated)")
     digest, body = data[len(MAGIC):len(MAGIC) + 32], data[len(MAGIC) + 32:]
     if hashlib.sha256(body).digest() != digest:
         raise CheckpointError(f"{path} is damaged: checksum mismatch (truncated or modified file)")
@@ -61,20 +63,19 @@ def read_with_digest(path: str) -> tuple:
         raise CheckpointError(f"{path} cannot be unpickled: {e}") from e
     if not isinstance(record, dict) or record.get("format_version") != FORMAT_VERSION:
         version = record.get("format_version") if isinstance(record, dict) else None
-        raise CheckpointError(f"{path} has format version {version}, expected {FORMAT_VERSION}")
+        raise CheckpointError(f"{path} is a checkpoint of format version {version}; this code reads version "
+                              f"{FORMAT_VERSION} (train it again, or use the release that wrote it)")
     lacking = [k for k in ("fingerprint", "payload") if not isinstance(record.get(k), dict)]
     if lacking:
         raise CheckpointError(f"{path} lacks its {' and '.join(lacking)} (not a whole checkpoint)")
     return record, digest.hex()
 
 
-def load(path: str, fingerprint: dict = None, upgrade=None) -> dict:
-    """Returns the payload; raises CheckpointError if damaged or if `fingerprint` differs from the
-    stored one (passed through `upgrade` first, e.g. to fill in fields older checkpoints lack)."""
+def load(path: str, fingerprint: dict = None) -> dict:
+    """Returns the payload; raises CheckpointError if damaged or if `fingerprint` differs from the stored one."""
     record = _read_record(path)
     if fingerprint is not None:
-        stored = record["fingerprint"] if upgrade is None else upgrade(record["fingerprint"])
-        check_fingerprint(stored, fingerprint, path)
+        check_fingerprint(record["fingerprint"], fingerprint, path)
     return record["payload"]
 
 

@@ -14,10 +14,8 @@ from typing import Callable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from agents import checkpoint
-from agents.domains import as_domain
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
-from robostrich_suite import cli as cli_lib
 
 
 @dataclasses.dataclass(frozen=True)
@@ -27,8 +25,9 @@ class Lesson:
     steps: int
 
 
-def parse_plan(text: str, default_domain: str = "robostrich") -> List[Lesson]:
-    """'lesson1:50000,lesson2:50000' or 'point_mass/easy:2000' -> [Lesson, ...]."""
+def parse_plan(text: str, default_domain: Optional[str] = None) -> List[Lesson]:
+    """'point_mass/easy:2000,point_mass/hard:5000' -> [Lesson, ...]; a lesson without a domain
+    ('easy:2000') is on ``default_domain``."""
     lessons = []
     for item in filter(None, (s.strip() for s in text.split(","))):
         try:
@@ -37,6 +36,8 @@ def parse_plan(text: str, default_domain: str = "robostrich") -> List[Lesson]:
         except (ValueError, OverflowError):
             raise ValueError(f"bad lesson {item!r}: expected [domain/]task:steps") from None
         domain, task = name.split("/", 1) if "/" in name else (default_domain, name)
+        if domain is None:
+            raise ValueError(f"lesson {item!r} names no domain: expected domain/task:steps")
         if steps <= 0:
             raise ValueError(f"lesson {item!r} has a non-positive step budget")
         lessons.append(Lesson(domain, task, steps))
@@ -49,94 +50,11 @@ def format_plan(plan: Sequence[Lesson]) -> str:
     return ",".join(f"{l.domain}/{l.task}:{l.steps}" for l in plan)
 
 
-def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, task_kwargs: Optional[dict] = None,
-                 layout: Optional[str] = None, init_from: Optional[str] = None) -> dict:
+def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, extra: Optional[dict] = None) -> dict:
     """What makes two runs the same run: the part of a checkpoint's fingerprint known before building it
-    (robostrich-train checks a resume against it before touching anything).  ``init_from``: the content
-    hash of the checkpoint the run started from (agents/transfer.py), if any."""
-    identity = {"config": config.to_dict(), "plan": format_plan(plan), "seed": seed}
-    if task_kwargs:
-        identity["task_kwargs"] = dict(task_kwargs)
-    layout = named_layout(layout, plan)
-    if layout is not None:
-        identity["layout"] = layout
-    if init_from is not None:
-        identity["init_from"] = init_from
-    return identity
-
-
-# Arm checkpoints that name no tendon layout were trained on the tasks' routing of their day, the one
-# now called ventral_from_base (the default became ventral_slips on 2026-12-02); runs since name theirs.
-LEGACY_UNNAMED_LAYOUT = "ventral_from_base"
-
-
-def _is_arm_plan(plan) -> bool:
-    return bool(plan) and all(as_domain(lesson.domain).is_arm for lesson in plan)
-
-
-def named_layout(layout: Optional[str], plan) -> Optional[str]:
-    """The tendon layout a run on ``plan`` trains, by name: ``layout``, or the tasks' default on
-    the arm domains (None off them)."""
-    if layout is not None or not _is_arm_plan(plan):
-        return layout
-    return as_domain(plan[-1].domain).layout  # the arm domain names its default
-
-
-def upgrade_fingerprint(fingerprint: dict) -> dict:
-    """A stored fingerprint with the config fields its checkpoint predates filled in as its run had
-    them (`SACConfig.LEGACY_VALUES`), to compare with a fingerprint of today's code; an arm run's
-    task arguments without the main job's later defaults get the values that run trained with
-    (`ARM_TASK_LEGACY_VALUES`: the task's own defaults)."""
-    fingerprint = _with_legacy_task_kwargs(fingerprint)
-    if "layout" not in fingerprint:
-        try:
-            if _is_arm_plan(parse_plan(fingerprint.get("plan", ""))):
-                fingerprint = {**fingerprint, "layout": LEGACY_UNNAMED_LAYOUT}
-        except (TypeError, ValueError):
-            pass  # not a plan of this program: the comparison names what differs
-    if not isinstance(fingerprint.get("config"), dict):
-        return fingerprint
-    try:
-        config = SACConfig.from_dict(fingerprint["config"]).to_dict()
-    except (TypeError, ValueError):
-        return fingerprint  # another program's config: the comparison names what differs
-    return {**fingerprint, "config": config}
-
-
-# Task arguments the main job on the arm gained a default for, and what a run recorded without one
-# trained with: the uniform draw of targets (before the twelfth session) and fixed starts in
-# lessons 1-2 (before the thirteenth); inside eq. 10's weights, no attitude-precision term (before
-# the fourteenth).
-ARM_TASK_LEGACY_VALUES = {"target_sampling": "uniform", "fixed_stored_starts": 0.0}
-ARM_WEIGHT_LEGACY_VALUES = {"attitude_precision": 0.0}
-
-
-def _with_legacy_task_kwargs(fingerprint: dict) -> dict:
-    """``upgrade_fingerprint``'s part for the task arguments: only an arm run's, whose tasks all
-    take these arguments (a dm_control task has no such argument)."""
-    task_kwargs = fingerprint.get("task_kwargs")
-    if not isinstance(task_kwargs, dict):
-        return fingerprint
-    weights = task_kwargs.get("weights")
-    missing_weights = isinstance(weights, dict) and not all(k in weights for k in ARM_WEIGHT_LEGACY_VALUES)
-    if all(k in task_kwargs for k in ARM_TASK_LEGACY_VALUES) and not missing_weights:
-        return fingerprint
-    try:
-        arm = _is_arm_plan(parse_plan(fingerprint.get("plan", "")))
-    except (TypeError, ValueError):
-        return fingerprint  # not a plan of this program: the comparison names what differs
-    if not arm:
-        return fingerprint
-    upgraded = {**ARM_TASK_LEGACY_VALUES, **task_kwargs}
-    if missing_weights:
-        upgraded["weights"] = {**ARM_WEIGHT_LEGACY_VALUES, **weights}
-    return {**fingerprint, "task_kwargs": upgraded}
-
-
-def make_environment(domain, task: str, seed: int, **task_kwargs):
-    """robostrich_suite.load for the arm domains, dm_control.suite.load otherwise (agents/domains.py);
-    `domain` is a name or an agents.domains.Domain (which may carry a tendon layout)."""
-    return as_domain(domain).make_environment(task, seed, **task_kwargs)
+    (a resume is checked against it before anything is touched); ``extra``: what the environments
+    add (their options, say), in the fingerprint beside the config, the plan and the seed."""
+    return {"config": config.to_dict(), "plan": format_plan(plan), "seed": seed, **(extra or {})}
 
 
 class TrainingInterrupted(RuntimeError):
@@ -149,16 +67,14 @@ def run_files(run_dir: str) -> Tuple[str, str, str]:
             os.path.join(run_dir, "evals.jsonl"))
 
 
-def check_lesson_names(plan, config: SACConfig, layout: Optional[str] = None) -> None:
-    """ValueError naming the field if a per-lesson setting names a task the plan's domains lack:
-    a misspelt lesson would silently turn its setting off (dm_control's tasks have no goal reward,
-    so HER does not apply there; a per-lesson discount applies to any plan). An unknown `layout`,
-    or one on a dm_control plan, fails here too."""
-    arm_domains = {d for d in (as_domain(lesson.domain, layout) for lesson in plan) if d.is_arm}
-    named = {"her_lessons": config.her_lessons if config.her_ratio > 0 and arm_domains else (),
+def check_lesson_names(plan, config: SACConfig, other_tasks: Sequence[str] = (), goal_tasks: bool = True) -> None:
+    """ValueError naming the field if a per-lesson setting names a task that is neither in ``plan``
+    nor in ``other_tasks``: a misspelt lesson would silently turn its setting off. ``goal_tasks``:
+    whether the plan's tasks have goals (``her_lessons`` is checked only then, as HER applies only there)."""
+    named = {"her_lessons": config.her_lessons if config.her_ratio > 0 and goal_tasks else (),
              "long_horizon_lessons": config.long_horizon_lessons,
              "exploration_lessons": config.exploration_lessons}
-    known = {lesson.task for lesson in plan} | {task for domain in arm_domains for task in domain.tasks()}
+    known = {lesson.task for lesson in plan} | set(other_tasks)
     for field, lessons in named.items():
         unknown = sorted(set(lessons) - known)
         if unknown:
@@ -178,38 +94,31 @@ class CurriculumRun:
     """
 
     def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
-                 checkpoint_every: int = 10_000, env_factory: Callable = make_environment, name: str = "run",
-                 task_kwargs: Optional[dict] = None, layout: Optional[str] = None,
-                 init_from: Optional[str] = None, keep_lesson_checkpoints: bool = False):
-        """``task_kwargs`` go to every lesson's task (e.g. eq. 10's ``weights``); ``layout`` names a
-        built-in tendon layout of the arm domains (its own targets come with it); ``init_from`` is the
-        content hash of the checkpoint whose learner this run starts from (agents/transfer.initialize
-        puts it there), kept in the fingerprint. ``keep_lesson_checkpoints`` also writes a checkpoint
-        at the end of every lesson but the last, ``after_lessonK.pkl`` (K lessons done), which
-        robostrich-evaluate and the application tools load as the policy of the first K lessons."""
+                 make_environment: Callable, checkpoint_every: int = 10_000, name: str = "run",
+                 base_policy: Optional[Callable] = None, identity: Optional[dict] = None,
+                 episode_probe: Optional[Callable] = None, keep_lesson_checkpoints: bool = False):
+        """``make_environment(lesson, seed)`` builds a lesson's environment; ``base_policy``, a
+        residual policy's base (see SACBuilder); ``identity``, what the fingerprint holds beside the
+        config, plan and seed (the environments' options); ``episode_probe(env)``, the metrics an
+        episode's record gets from its last state (SACBuilder.make_components).
+        ``keep_lesson_checkpoints`` also writes a checkpoint at the end of every lesson but the
+        last, ``after_lessonK.pkl`` (K lessons done): the policy of the first K lessons."""
         self.keep_lesson_checkpoints = bool(keep_lesson_checkpoints)
-        self.task_kwargs = dict(task_kwargs or {})
-        self.layout = layout
-        self.init_from = init_from
-        check_lesson_names(plan, config, layout)  # and an unknown layout fails here, not mid-run
         self.plan = list(plan)
         self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
+        self.identity = dict(identity or {})
         self.checkpoint_every = int(checkpoint_every)
-        self.env_factory = env_factory
+        self.make_environment = make_environment
         self.lesson_index = 0
         self.lesson_steps = 0
         os.makedirs(run_dir, exist_ok=True)
-        base = self.domain(self.plan[0])  # a residual policy adds to this domain's (and layout's) lookup
-        self.loop = SACBuilder(config).make_components(self._make_lesson_env(0), seed,
-                                                       base.lookup_table() if config.residual_scale > 0 else None)
+        self.loop = SACBuilder(config).make_components(self._make_lesson_env(0), seed, base_policy, episode_probe)
         self._enter_lesson()
         self.checkpoint_path, self.metrics_path, self.evals_path = run_files(run_dir)
 
     # -- lessons ---------------------------------------------------------------------------
     def _make_lesson_env(self, index):
-        lesson = self.plan[index]
-        return self.env_factory(self.domain(lesson), lesson.task, self.seed + 1000 * (index + 1),
-                                **self.task_kwargs)
+        return self.make_environment(self.plan[index], self.seed + 1000 * (index + 1))
 
     def _enter_lesson(self):
         """What the loop changes with the lesson besides the environment: the hindsight share,
@@ -223,10 +132,6 @@ class CurriculumRun:
     def lesson_checkpoint_path(self, lessons_done: int) -> str:
         """Where ``keep_lesson_checkpoints`` writes the checkpoint after ``lessons_done`` lessons."""
         return os.path.join(self.run_dir, f"after_lesson{lessons_done}.pkl")
-
-    def domain(self, lesson: Optional[Lesson] = None):
-        """The agents.domains.Domain of `lesson` (default: the last), with this run's layout."""
-        return as_domain((lesson or self.plan[-1]).domain, self.layout)
 
     @property
     def total_steps(self) -> int:
@@ -245,9 +150,13 @@ class CurriculumRun:
 
     # -- checkpoints -----------------------------------------------------------------------
     def fingerprint(self) -> dict:
-        return {**run_identity(self.plan, self.config, self.seed, self.task_kwargs, self.layout, self.init_from),
+        return {**run_identity(self.plan, self.config, self.seed, self.extra_identity()),
                 "observation_layout": self.loop.flattener.describe(),
                 "action_size": self.loop.actor.adapter.size}
+
+    def extra_identity(self) -> dict:
+        """What the fingerprint holds beside config, plan and seed (``identity``, by default)."""
+        return self.identity
 
     def state_dict(self) -> dict:
         loop = self.loop
@@ -272,22 +181,21 @@ class CurriculumRun:
     def save_checkpoint(self, path: Optional[str] = None):
         checkpoint.save(path or self.checkpoint_path, self.state_dict(), self.fingerprint())
 
-    # What `restore` reads from a checkpoint's payload (others are optional: older checkpoints lack them).
-    STATE_FIELDS = ("learner", "actor_key", "replay", "loop", "lesson_index", "lesson_steps", "environment")
+    # What `restore` reads from a checkpoint's payload.
+    STATE_FIELDS = ("learner", "actor_key", "actor_noise", "replay", "loop", "lesson_index", "lesson_steps",
+                    "environment", "latest_metrics")
 
     def restore(self, path: Optional[str] = None):
         path = path or self.checkpoint_path
-        # Both sides upgraded: a task argument left out means the task's default, then as now.
-        state = checkpoint.load(path, upgrade_fingerprint(self.fingerprint()), upgrade=upgrade_fingerprint)
-        missing = [k for k in self.STATE_FIELDS if k not in state] if isinstance(state, dict) else list(self.STATE_FIELDS)
+        state = checkpoint.load(path, self.fingerprint())
+        missing = [k for k in self.STATE_FIELDS if k not in state]
         if missing:
-            raise checkpoint.CheckpointError(f"{path} lacks the run state {missing} (not written by robostrich-train, "
-                                             "or by a version that stored less)")
+            raise checkpoint.CheckpointError(f"{path} lacks the run state {missing} (not written by a CurriculumRun)")
         loop = self.loop
         loop.learner.set_state(state["learner"])
         loop.actor.update(loop.learner.policy_params)
         loop.actor.key = np.asarray(state["actor_key"])
-        noise = state.get("actor_noise")  # absent in checkpoints written before correlated noise
+        noise = state["actor_noise"]
         loop.actor.noise = None if noise is None else np.asarray(noise, np.float32)
         loop.replay.load_state_dict(state["replay"])
         self.lesson_index, self.lesson_steps = state["lesson_index"], state["lesson_steps"]
@@ -297,21 +205,22 @@ class CurriculumRun:
             loop.set_environment(self._make_lesson_env(self.lesson_index), close_episode=False)
         self._enter_lesson()
         loop.load_state_dict(state["loop"])
-        loop.latest_metrics = state.get("latest_metrics", {})
+        loop.latest_metrics = state["latest_metrics"]
         for p in (self.metrics_path, self.evals_path):  # drop records written after the checkpoint
             _truncate_jsonl(p, loop.env_steps)
 
     # -- Algorithm 1 -----------------------------------------------------------------------
     def run(self, progress=None, on_eval: Optional[Callable] = None, eval_at: Sequence[int] = (),
-            stop_at_step: Optional[int] = None, chunk: int = 500):
+            stop_at_step: Optional[int] = None, chunk: int = 500, stop_requested: Callable[[], bool] = lambda: False):
         """Run the remaining plan. `on_eval(run)` is called when env_steps hits a value in eval_at.
-        Ctrl-C stops it between chunks: a checkpoint is written, then KeyboardInterrupt raised.
+        When `stop_requested()` turns true (polled between chunks: a Ctrl-C handler's flag, say) a
+        checkpoint is written, then KeyboardInterrupt raised.
         An episode a lesson's end cuts off gets its metrics line too (``"cut": true``)."""
-        with cli_lib.deferred_interrupts():
-            self._run(progress, on_eval, eval_at, stop_at_step, chunk)
+        self._stop_requested = stop_requested
+        self._run(progress, on_eval, eval_at, stop_at_step, chunk)
 
     def _stop_if_interrupted(self, metrics_file):
-        if cli_lib.interrupted():
+        if self._stop_requested():
             metrics_file.flush()
             self.save_checkpoint()
             raise KeyboardInterrupt(f"checkpoint written at step {self.loop.env_steps}: {self.checkpoint_path}")

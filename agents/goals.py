@@ -1,12 +1,12 @@
 """Goals in flat observations: hindsight relabelling (HER) and reward recomputation.
 
 A goal-reaching task whose reward is a function of the achieved pose and the
-goal (robostrich's eqs. 9 and 10) lets the agent ask "what would this
+goal lets the agent ask "what would this
 transition have earned had the target been g?" and get the exact answer. The
 task says where the goal sits in its observation (``GOAL_OBSERVATION``,
 ``ACHIEVED_OBSERVATION``, ``GOAL_DELTA_OBSERVATION``,
 ``ATTITUDE_ERROR_OBSERVATION``) and gives the reward with ``goal_reward``; the
-agent never looks at the arm itself.
+agent never looks at the system itself.
 
 Under an action repeat a transition spans several control steps whose rewards
 are summed, so the replay keeps the achieved position and attitude error after
@@ -45,7 +45,7 @@ class GoalRelabeler:
         if goal is None or achieved is None or task.ATTITUDE_ERROR_OBSERVATION not in slices:
             return None
         if goal.stop - goal.start != achieved.stop - achieved.start:
-            return None  # e.g. a 3-D head position against a 2-D target
+            return None  # e.g. a 3-D achieved position against a 2-D goal
         return cls(flattener, task, slices)
 
     def substep(self, flat_obs: np.ndarray) -> np.ndarray:
@@ -62,7 +62,7 @@ class GoalRelabeler:
 
     def settable(self, reached: np.ndarray) -> np.ndarray:
         """Which reached poses (..., g + 1) (position, attitude error in deg) are goals the task
-        could set: all of them unless the task asks for a level head."""
+        could set: all of them unless the task limits the attitude error of its goals."""
         if self.goal_attitude_tolerance is None:
             return np.ones(reached.shape[:-1], bool)
         return np.abs(reached[..., self.goal_size]) <= self.goal_attitude_tolerance

@@ -9,7 +9,6 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from agents import probes
 from agents.actors import Actor
 from agents.goals import GoalRelabeler
 from agents.replay import ObservationFlattener, ReplayBuffer
@@ -22,7 +21,9 @@ class EnvironmentLoop:
     curriculum sets it per lesson (SACConfig.her_lessons)."""
 
     def __init__(self, env, actor: Actor, replay: ReplayBuffer, learner, config,
-                 flattener: ObservationFlattener, seed: int = 0, label: str = ""):
+                 flattener: ObservationFlattener, seed: int = 0, label: str = "",
+                 episode_probe: Optional[Callable] = None):
+        self.episode_probe = episode_probe  # env -> metrics of an episode's last state, for its record
         self.actor, self.replay, self.learner, self.config = actor, replay, learner, config
         self.flattener = flattener
         self.label = label
@@ -122,12 +123,9 @@ class EnvironmentLoop:
         return self.env_steps - start
 
     def _episode_record(self) -> dict:
-        position_error, attitude_error = probes.head_errors(self.env)
+        probed = self.episode_probe(self.env) if self.episode_probe is not None else {}
         return {"env_steps": self.env_steps, "episode": self.episodes,
-                "return": self.episode_return, "length": self.episode_length,
-                "position_error": position_error, "attitude_error": attitude_error,
-                "success": probes.is_success(position_error, attitude_error, *probes.tolerances(self.env)),
-                "time": time.time()}
+                "return": self.episode_return, "length": self.episode_length, **probed, "time": time.time()}
 
     def cut_episode(self) -> Optional[dict]:
         """Count the open episode that a lesson's end cuts off and return its metrics (``"cut":

@@ -107,8 +107,8 @@ class ReplayBuffer:
         strategy), and their rewards are recomputed; ``relabel_rewards`` recomputes every
         row's reward with the relabeler's (the current lesson's) reward function. Rows that
         ended in a divergence (discount 0) keep their stored penalty. ``settable_goals_only``
-        relabels a row only when the later pose is a goal the task could set (a level head
-        where the reward asks for one, ``GoalRelabeler.settable``); the others keep theirs.
+        relabels a row only when the later pose is a goal the task could set (within the
+        task's attitude tolerance where its reward asks for one, ``GoalRelabeler.settable``); the others keep theirs.
         """
         if self.size == 0:
             raise ValueError("cannot sample from an empty replay buffer")

@@ -7,7 +7,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from agents import application_commands, applications, gap, stabilization
+from agents.robostrich import application_commands, applications, gap, stabilization
 from robostrich_suite.tasks import quadruped_tasks
 
 from conftest import console_script
@@ -69,10 +69,10 @@ def test_narrow_gap_reports_every_sub_target_with_contact_forces_from_a_real_rol
 
 
 def test_a_checkpoint_is_evaluated_beside_the_references(tmp_path):
-    from agents.curriculum import CurriculumRun, parse_plan
+    from agents.robostrich.runs import DomainRun, parse_plan
     from agents.sac.config import SACConfig
     config = SACConfig(batch_size=16, hidden_sizes=(16, 16), min_replay_size=50, max_replay_size=1000)
-    run = CurriculumRun(parse_plan("robostrich_a1/lesson1:100"), config, seed=0, run_dir=str(tmp_path / "run"))
+    run = DomainRun(parse_plan("robostrich_a1/lesson1:100"), config, seed=0, run_dir=str(tmp_path / "run"))
     run.save_checkpoint()
     result = application_commands.stabilize_main(
         [run.checkpoint_path, "--reference", run.checkpoint_path, "--seeds", "1", "--time-limit", "1.5",

@@ -14,8 +14,8 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TOOLS = os.path.join(ROOT, "tools")
 # The main job at its smallest: the final evaluation (3 labels, 1 held-out target) dominates its time.
-TINY_TRAINING = ["--plan", "lesson1:100,lesson2:100,lesson3:100", "--hidden", "16,16", "--batch-size", "16",
-                 "--min-replay", "20", "--num-eval-targets", "1", "--final-eval-targets", "1",
+TINY_TRAINING = ["--plan", "lesson1:100,lesson2:100,lesson3:100", "--hidden-sizes", "16,16", "--batch-size", "16",
+                 "--min-replay-size", "20", "--num-eval-targets", "1", "--final-eval-targets", "1",
                  "--eval-every", "1000000", "--quiet", "--no-rerun", "--no-figures"]
 
 
@@ -78,7 +78,7 @@ def test_seeds_passes_arguments_through_resumes_and_skips_finished_seeds(tmp_pat
     tool = load_tool("benchmark_seeds")
     calls = []
 
-    def fake_main(argv):  # stands in for agents.training.main: records argv, writes a summary, returns a dict
+    def fake_main(argv):  # stands in for agents.robostrich.training.main: records argv, writes a summary, returns a dict
         calls.append(list(argv))
         out = argv[argv.index("--out") + 1]
         os.makedirs(out, exist_ok=True)
@@ -86,10 +86,10 @@ def test_seeds_passes_arguments_through_resumes_and_skips_finished_seeds(tmp_pat
             json.dump(summary(1.0, 0.01, 1.0), f)
         return {"not": "an exit code"}
 
-    import agents
+    import agents.robostrich
     fake = types.SimpleNamespace(main=fake_main)
-    monkeypatch.setitem(sys.modules, "agents.training", fake)
-    monkeypatch.setattr(agents, "training", fake, raising=False)
+    monkeypatch.setitem(sys.modules, "agents.robostrich.training", fake)
+    monkeypatch.setattr(agents.robostrich, "training", fake, raising=False)
     out = tmp_path / "seeds"
     os.makedirs(out / "seed_1" / "baseline")
     (out / "seed_1" / "baseline" / "checkpoint.pkl").write_bytes(b"")  # killed after a checkpoint
@@ -139,7 +139,7 @@ def test_benchmark_dmc_end_to_end_on_cartpole(tmp_path, tool_env):
     out = tmp_path / "dmc"
     # min-replay 20 transitions = 160 control steps at action repeat 8: the agent learns before each evaluation
     run_tool("benchmark_dmc", "--tasks", "cartpole/swingup", "--steps", "400", "--eval-at", "200,400",
-             "--min-replay", "20", "--hidden", "16,16", "--batch-size", "16", "--eval-episodes", "2",
+             "--min-replay-size", "20", "--hidden-sizes", "16,16", "--batch-size", "16", "--eval-episodes", "2",
              "--out", str(out), "--quiet", cwd=tmp_path, env=tool_env)
     result = json.loads((out / "dmc.json").read_text())
     rows = result["rows"]

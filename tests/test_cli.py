@@ -18,8 +18,8 @@ from robostrich_suite.model import layouts
 
 from conftest import finish, start
 
-TINY_TRAIN = ["--plan", "lesson1:250", "--no-baseline", "--hidden", "16,16", "--batch-size", "16",
-              "--min-replay", "50", "--num-eval-targets", "1", "--final-eval-targets", "1", "--quiet",
+TINY_TRAIN = ["--plan", "lesson1:250", "--no-baseline", "--hidden-sizes", "16,16", "--batch-size", "16",
+              "--min-replay-size", "50", "--num-eval-targets", "1", "--final-eval-targets", "1", "--quiet",
               "--no-rerun", "--no-figures"]
 
 
@@ -145,7 +145,7 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     assert_user_error(results["checkpoint_every_0"], "--checkpoint-every")
     assert results["checkpoint_every_0"].returncode == 2 and not (tmp_path / "ck0").exists()
     assert_user_error(results["truncated"], "truncated.pkl", "damaged")
-    assert_user_error(results["empty"], "empty.pkl", "not a robostrich SAC checkpoint")
+    assert_user_error(results["empty"], "empty.pkl", "not a SAC checkpoint")
     assert_user_error(results["ramp_negative"], "--ramp-time")
     assert not list(tmp_path.glob("mv/*.rrd"))  # refused before the recording was opened
     assert_user_error(results["layout"], "unknown layout 'tangled'")

@@ -1,11 +1,11 @@
-"""The domain adapter (agents/domains.py): each arm domain and tendon layout trains and is judged on its own
+"""The domain adapter (agents/robostrich/domains.py): each arm domain and tendon layout trains and is judged on its own
 targets, with its own lookup table; dm_control domains keep working; bad names are errors that name them."""
 import numpy as np
 import pytest
 
 from agents import checkpoint
-from agents.curriculum import CurriculumRun, parse_plan
-from agents.domains import Domain
+from agents.robostrich.runs import DomainRun, parse_plan
+from agents.robostrich.domains import Domain
 from agents.sac.config import SACConfig
 from robostrich_suite import targets
 from robostrich_suite.model import layouts
@@ -70,7 +70,7 @@ def test_bad_domain_layout_and_task_names_are_errors_that_name_them():
 
 def test_curriculum_runs_every_lesson_on_the_quadruped_and_carries_the_learner(tmp_path):
     plan = parse_plan("lesson1:60,lesson2:60,lesson3:60,lesson4:60", default_domain="robostrich_a1")
-    run = CurriculumRun(plan, TINY, 0, str(tmp_path / "a1"), checkpoint_every=10 ** 6)
+    run = DomainRun(plan, TINY, 0, str(tmp_path / "a1"), checkpoint_every=10 ** 6)
     learner = run.loop.learner
     run.run()
     assert run.done and run.loop.env_steps == 240
@@ -82,14 +82,14 @@ def test_curriculum_runs_every_lesson_on_the_quadruped_and_carries_the_learner(t
 
 def test_a_layout_is_part_of_the_checkpoint(tmp_path):
     plan = parse_plan("lesson1:40")
-    run = CurriculumRun(plan, TINY, 0, str(tmp_path / "run"), layout=LAYOUT)
+    run = DomainRun(plan, TINY, 0, str(tmp_path / "run"), layout=LAYOUT)
     assert run.fingerprint()["layout"] == LAYOUT
     run.run()
-    other = CurriculumRun(plan, TINY, 0, str(tmp_path / "other"))  # the paper's layout
+    other = DomainRun(plan, TINY, 0, str(tmp_path / "other"))  # the paper's layout
     with pytest.raises(checkpoint.CheckpointError, match="layout"):
         other.restore(run.checkpoint_path)
     with pytest.raises(ValueError, match="arm domains"):
-        CurriculumRun(parse_plan("reacher/easy:10"), TINY, 0, str(tmp_path / "r"), layout=LAYOUT)
+        DomainRun(parse_plan("reacher/easy:10"), TINY, 0, str(tmp_path / "r"), layout=LAYOUT)
 
 
 def test_periodic_evaluation_targets_spread_over_the_held_out_set():
@@ -107,7 +107,7 @@ def test_periodic_evaluation_targets_spread_over_the_held_out_set():
 def test_default_lessons_are_the_domains_curriculum():
     """Without --lessons/--plan, robostrich-train runs Algorithm 1 of the chosen domain: lessons 1-3
     on the frame, 1-4 (lesson 4 trotting) on the quadruped; a dm_control domain must name its tasks."""
-    from agents import training
+    from agents.robostrich import training
     parse = training.build_parser().parse_args
     frame = training.plan_from_args(parse(["--steps", "300"]))
     assert [(l.domain, l.task, l.steps) for l in frame] == [
@@ -124,14 +124,14 @@ def test_quadruped_curriculum_resumes_mid_lesson4_exactly(tmp_path):
     restored from its checkpoint continues exactly as the run that was never stopped."""
     from agents.curriculum import TrainingInterrupted
     plan = parse_plan("lesson3:40,lesson4:80", default_domain="robostrich_a1")
-    whole = CurriculumRun(plan, TINY, 0, str(tmp_path / "whole"), checkpoint_every=10 ** 6)
+    whole = DomainRun(plan, TINY, 0, str(tmp_path / "whole"), checkpoint_every=10 ** 6)
     whole.run()
-    first = CurriculumRun(plan, TINY, 0, str(tmp_path / "killed"), checkpoint_every=10 ** 6)
+    first = DomainRun(plan, TINY, 0, str(tmp_path / "killed"), checkpoint_every=10 ** 6)
     with pytest.raises(TrainingInterrupted):
         first.run(stop_at_step=90)  # 50 steps into lesson 4
     assert first.lesson.task == "lesson4" and first.loop.env.task.legs == "walk"
     first.save_checkpoint()
-    resumed = CurriculumRun(plan, TINY, 0, str(tmp_path / "killed"), checkpoint_every=10 ** 6)
+    resumed = DomainRun(plan, TINY, 0, str(tmp_path / "killed"), checkpoint_every=10 ** 6)
     resumed.restore()
     resumed.run()
     assert resumed.loop.env_steps == whole.loop.env_steps == 120

@@ -5,7 +5,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from agents.curriculum import CurriculumRun, TrainingInterrupted, parse_plan
+from agents.curriculum import TrainingInterrupted
+from agents.robostrich.runs import DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
 HER = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=100, max_replay_size=5000,
@@ -14,7 +15,7 @@ HER = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=100, max_r
 
 
 def filled_run(tmp_path, plan="robostrich/lesson2:1500", config=HER, seed=0):
-    run = CurriculumRun(parse_plan(plan), config, seed=seed, run_dir=str(tmp_path), checkpoint_every=10_000)
+    run = DomainRun(parse_plan(plan), config, seed=seed, run_dir=str(tmp_path), checkpoint_every=10_000)
     run.run()
     return run
 
@@ -61,12 +62,12 @@ def test_hindsight_goals_are_reached_later_in_the_same_episode(run):
 
 def test_resumed_her_run_is_bit_exact(tmp_path):
     plan = parse_plan("robostrich/lesson1:600,robostrich/lesson2:600")
-    a = CurriculumRun(plan, HER, seed=3, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
+    a = DomainRun(plan, HER, seed=3, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
     with pytest.raises(TrainingInterrupted):
         a.run(stop_at_step=740)  # mid-episode in lesson 2, after learning started
     path = str(tmp_path / "ckpt.pkl")
     a.save_checkpoint(path)
-    b = CurriculumRun(plan, HER, seed=3, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
+    b = DomainRun(plan, HER, seed=3, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
     b.restore(path)
     a.run()
     b.run()
@@ -83,13 +84,13 @@ def test_task_kwargs_reach_every_lesson_and_the_checkpoint_fingerprint(tmp_path)
     other weights is refused on resume."""
     plan = parse_plan("robostrich/lesson1:100,robostrich/lesson2:100")
     weights = {"weights": {"position_error": 10.0}}
-    run = CurriculumRun(plan, HER, seed=0, run_dir=str(tmp_path / "a"), task_kwargs=weights)
+    run = DomainRun(plan, HER, seed=0, run_dir=str(tmp_path / "a"), task_kwargs=weights)
     assert run.loop.env.task.weights.position_error == 10.0
     run.run()
     assert run.done
     path = str(tmp_path / "ckpt.pkl")
     run.save_checkpoint(path)
-    plain = CurriculumRun(plan, HER, seed=0, run_dir=str(tmp_path / "b"))
+    plain = DomainRun(plan, HER, seed=0, run_dir=str(tmp_path / "b"))
     assert plain.loop.env.task.weights.position_error == 2.0
     with pytest.raises(ValueError, match="task_kwargs"):
         plain.restore(path)
@@ -100,7 +101,7 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
     targets, and a run resumed in lesson 2 keeps HER off."""
     plan = parse_plan("robostrich/lesson1:600,robostrich/lesson2:600")
     config = dataclasses.replace(HER, her_lessons=("lesson1",))
-    run = CurriculumRun(plan, config, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
+    run = DomainRun(plan, config, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
     assert run.loop.her_ratio == 0.5
     with pytest.raises(TrainingInterrupted):
         run.run(stop_at_step=800)
@@ -116,17 +117,17 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
     assert relabelled_share(config.her_ratio_in_lesson("lesson1")) > 0.3  # what lesson 1 sampled
     path = str(tmp_path / "ckpt.pkl")
     run.save_checkpoint(path)
-    resumed = CurriculumRun(plan, config, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
+    resumed = DomainRun(plan, config, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
     assert resumed.loop.her_ratio == 0.5  # lesson 1 until the checkpoint says otherwise
     resumed.restore(path)
     assert resumed.loop.her_ratio == 0.0
     with pytest.raises(ValueError, match="her_lessons"):
         SACConfig(her_ratio=0.5, her_lessons="lesson1")  # a string, not a tuple of names
-    off = CurriculumRun(plan, dataclasses.replace(HER, her_ratio=0.0, her_lessons=("lesson_1",)), seed=1,
+    off = DomainRun(plan, dataclasses.replace(HER, her_ratio=0.0, her_lessons=("lesson_1",)), seed=1,
                         run_dir=str(tmp_path / "off"))  # --her-ratio 0 turns HER off whatever the lessons say
     assert off.loop.her_ratio == 0.0
     with pytest.raises(ValueError, match=r"her_lessons names \['lesson_1'\]"):
-        CurriculumRun(plan, dataclasses.replace(HER, her_lessons=("lesson_1",)), seed=1,
+        DomainRun(plan, dataclasses.replace(HER, her_lessons=("lesson_1",)), seed=1,
                       run_dir=str(tmp_path / "c"))
 
 

@@ -21,7 +21,7 @@ from conftest import finish, start
 
 pytestmark = pytest.mark.usefixtures("shared_jax_cache")
 
-TRAIN = ["--plan", "lesson1:300,lesson2:300", "--hidden", "16,16", "--batch-size", "16", "--min-replay", "50",
+TRAIN = ["--plan", "lesson1:300,lesson2:300", "--hidden-sizes", "16,16", "--batch-size", "16", "--min-replay-size", "50",
          "--num-eval-targets", "1", "--final-eval-targets", "1", "--eval-every", "600", "--track-task", "",
          "--quiet", "--no-rerun", "--no-figures"]
 
@@ -55,12 +55,12 @@ FLAG_CASES = {  # (command, arguments, fragments the one line must hold)
     "plan_huge": ("robostrich-train", ["--plan", "lesson1:1e12"], ["--plan", "100000000"]),
     "lr_negative": ("robostrich-train", ["--learning-rate", "-1"], ["--learning-rate"]),
     "lr_nan": ("robostrich-train", ["--learning-rate", "nan"], ["--learning-rate", "nan"]),
-    "hidden_0": ("robostrich-train", ["--hidden", "0"], ["--hidden"]),
-    "hidden_negative": ("robostrich-train", ["--hidden", "-3"], ["--hidden"]),
+    "hidden_0": ("robostrich-train", ["--hidden-sizes", "0"], ["--hidden-sizes"]),
+    "hidden_negative": ("robostrich-train", ["--hidden-sizes", "-3"], ["--hidden-sizes"]),
     "log_std": ("robostrich-train", ["--log-std-min", "5", "--log-std-max", "-5"], ["--log-std-min", "--log-std-max"]),
     "temperature": ("robostrich-train", ["--init-temperature", "-1"], ["--init-temperature"]),
     "lessons_empty": ("robostrich-train", ["--lessons", ","], ["--lessons"]),
-    "replay_huge": ("robostrich-train", ["--replay-size", "1000000000000"], ["--replay-size", "10000000"]),
+    "replay_huge": ("robostrich-train", ["--max-replay-size", "1000000000000"], ["--max-replay-size", "10000000"]),
     "train_track_task": ("robostrich-train", ["--track-task", "nope"], ["--track-task", "nope"]),
     "train_heldout_track": ("robostrich-train", ["--heldout-task", "track"], ["--heldout-task", "track"]),
     "task_kwargs_far": ("robostrich-train", ["--task-kwargs", '{"target_pool": [[5, 0]]}'],
@@ -170,8 +170,9 @@ def test_incomplete_checkpoints_and_task_names_are_refused_before_any_work(tmp_p
                    "seed": 0, "observation_layout": [], "action_size": 9}
     empty, whole = tmp_path / "empty.pkl", tmp_path / "whole.pkl"
     checkpoint.save(str(empty), {}, fingerprint)
-    checkpoint.save(str(whole), {k: None for k in ("learner", "actor_key", "replay", "loop", "lesson_index",
-                                                   "lesson_steps", "environment")}, fingerprint)
+    checkpoint.save(str(whole), {k: None for k in ("learner", "actor_key", "actor_noise", "replay", "loop",
+                                                   "lesson_index", "lesson_steps", "environment",
+                                                   "latest_metrics")}, fingerprint)
     checkpoint.save(str(tmp_path / "no_plan.pkl"), {}, {"seed": 0})
     cases = {
         "evaluate": (start("robostrich-evaluate", empty, "--out", tmp_path / "e"), ["empty.pkl", "learner"]),

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from dm_env import specs
 
-from agents import evaluation
-from agents.curriculum import CurriculumRun, make_environment, parse_plan
-from agents.lookup import LookupPolicy, lookup_table
+from agents.robostrich import evaluation
+from agents.robostrich.runs import DomainRun, make_environment, parse_plan
+from agents.robostrich.lookup import LookupPolicy, lookup_table
 from agents.replay import ObservationFlattener
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
@@ -81,7 +81,7 @@ def test_heldout_moving_starts_from_poses_holding_other_targets(flattener):
 
 def test_evaluation_on_reacher_reports_returns_not_nan(tmp_path):
     config = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=200, max_replay_size=5000)
-    run = CurriculumRun(parse_plan("reacher/easy:1000"), config, seed=0, run_dir=str(tmp_path / "run"))
+    run = DomainRun(parse_plan("reacher/easy:1000"), config, seed=0, run_dir=str(tmp_path / "run"))
     actor = SACBuilder.make_eval_actor(run.loop)  # untrained
     reports = evaluation.evaluate_agent(actor, run.loop.flattener, str(tmp_path / "ev"), "sac", "reacher", "easy",
                                         None, num_targets=2, record=False)
@@ -102,7 +102,7 @@ def test_evaluation_on_reacher_reports_returns_not_nan(tmp_path):
 def test_evaluation_judges_success_with_the_tasks_own_tolerances():
     """A task built with a 2 cm tolerance is scored against 2 cm, not the paper's 5 cm."""
     from robostrich_suite import targets
-    from agents.lookup import LookupPolicy
+    from agents.robostrich.lookup import LookupPolicy
     from agents.replay import ObservationFlattener
     import robostrich_suite
     target = targets.heldout_targets()[:1]  # the lookup holds a neighbour: about a centimetre off
@@ -141,7 +141,7 @@ def test_untrained_residual_agent_is_the_lookup(flattener, tmp_path):
     """The policy's mean head starts at zero, so before any update the residual agent's
     deterministic action is the lookup's and it lands where the lookup lands."""
     config = SACConfig(residual_scale=0.25, min_replay_size=10, her_ratio=0.0)
-    run = CurriculumRun(parse_plan("lesson2:100"), config, seed=0, run_dir=str(tmp_path / "run"))
+    run = DomainRun(parse_plan("lesson2:100"), config, seed=0, run_dir=str(tmp_path / "run"))
     actor = SACBuilder.make_eval_actor(run.loop)
     target = targets.heldout_targets()[:2]
     agent = evaluation.evaluate_heldout(actor, run.loop.flattener, "robostrich", "lesson2", targets=target)

@@ -10,9 +10,9 @@ import pytest
 from conftest import console_script
 
 import robostrich_suite
-from agents.curriculum import CurriculumRun, parse_plan
-from agents.evaluation import evaluate_track
-from agents.policy_export import export_policy
+from agents.robostrich.runs import DomainRun, parse_plan
+from agents.robostrich.evaluation import evaluate_track
+from agents.robostrich.policy_export import export_policy
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from robostrich_suite import policies
@@ -54,7 +54,7 @@ def test_policy_file_errors_name_the_file(tmp_path):
 
 def test_exported_policy_acts_as_its_runs_evaluation_actor(tmp_path):
     config = SACConfig(batch_size=16, hidden_sizes=(16, 16), min_replay_size=50, max_replay_size=2000)
-    run = CurriculumRun(parse_plan("lesson1:300"), config, seed=3, run_dir=str(tmp_path / "run"),
+    run = DomainRun(parse_plan("lesson1:300"), config, seed=3, run_dir=str(tmp_path / "run"),
                         checkpoint_every=300)
     run.run()
     path = tmp_path / "policy.npz"

@@ -6,14 +6,16 @@ import jax
 import numpy as np
 import pytest
 
-from agents import checkpoint, training
-from agents.curriculum import CurriculumRun, TrainingInterrupted, parse_plan
+from agents import checkpoint
+from agents.robostrich import training
+from agents.curriculum import TrainingInterrupted
+from agents.robostrich.runs import DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
 TINY = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=200, max_replay_size=5000,
                  updates_per_call=4, env_steps_per_call=8)
-TINY_ARGS = ["--domain", "point_mass", "--hidden", "32,32", "--batch-size", "32", "--min-replay", "200",
-             "--replay-size", "5000", "--updates-per-call", "4", "--env-steps-per-call", "8",
+TINY_ARGS = ["--domain", "point_mass", "--hidden-sizes", "32,32", "--batch-size", "32", "--min-replay-size", "200",
+             "--max-replay-size", "5000", "--updates-per-call", "4", "--env-steps-per-call", "8",
              "--num-eval-targets", "1", "--no-figures", "--no-rerun", "--quiet", "--no-baseline"]
 
 
@@ -24,7 +26,7 @@ def leaves(tree):
     return arrays
 
 
-def assert_same_run(a: CurriculumRun, b: CurriculumRun):
+def assert_same_run(a: DomainRun, b: DomainRun):
     for x, y in zip(leaves(a.loop.learner.state), leaves(b.loop.learner.state), strict=True):
         np.testing.assert_array_equal(x, y)
     np.testing.assert_array_equal(np.asarray(a.loop.actor.key), np.asarray(b.loop.actor.key))
@@ -38,13 +40,13 @@ def assert_same_run(a: CurriculumRun, b: CurriculumRun):
 
 def test_checkpoint_round_trips_bit_exactly_and_continues_identically(tmp_path):
     plan = parse_plan("point_mass/easy:700")
-    a = CurriculumRun(plan, TINY, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
+    a = DomainRun(plan, TINY, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
     with pytest.raises(TrainingInterrupted):
         a.run(stop_at_step=450)  # mid-episode, after learning started
     assert a.loop.learner.num_updates > 0
     path = str(tmp_path / "ckpt.pkl")
     a.save_checkpoint(path)
-    b = CurriculumRun(plan, TINY, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
+    b = DomainRun(plan, TINY, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
     b.restore(path)
     assert_same_run(a, b)
     a.run()
@@ -77,20 +79,20 @@ def test_killed_and_resumed_run_matches_an_uninterrupted_one(tmp_path):
 
 def test_mismatched_or_damaged_checkpoint_raises(tmp_path):
     plan = parse_plan("point_mass/easy:300")
-    a = CurriculumRun(plan, TINY, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300)
+    a = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300)
     a.run()
     other = SACConfig(**{**TINY.to_dict(), "batch_size": 64, "hidden_sizes": (32, 32)})
-    b = CurriculumRun(plan, other, seed=0, run_dir=str(tmp_path / "b"))
+    b = DomainRun(plan, other, seed=0, run_dir=str(tmp_path / "b"))
     with pytest.raises(ValueError, match="batch_size: checkpoint has 32, this run has 64"):
         b.restore(a.checkpoint_path)
-    c = CurriculumRun(plan, TINY, seed=5, run_dir=str(tmp_path / "c"))
+    c = DomainRun(plan, TINY, seed=5, run_dir=str(tmp_path / "c"))
     with pytest.raises(ValueError, match="seed"):
         c.restore(a.checkpoint_path)
     data = bytearray(open(a.checkpoint_path, "rb").read())
     data[len(data) // 2] ^= 0xFF
     damaged = str(tmp_path / "damaged.pkl")
     open(damaged, "wb").write(bytes(data))
-    d = CurriculumRun(plan, TINY, seed=0, run_dir=str(tmp_path / "d"))
+    d = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "d"))
     with pytest.raises(ValueError, match="damaged"):
         d.restore(damaged)
     open(damaged, "wb").write(bytes(data[:20]))
@@ -98,83 +100,35 @@ def test_mismatched_or_damaged_checkpoint_raises(tmp_path):
         d.restore(damaged)
 
 
-def test_checkpoint_from_before_a_config_field_loads_as_its_run_had_it(tmp_path):
-    """A fingerprint without her_lessons and target_entropy_per_action (written before they
-    existed) means every-lesson HER and Acme's -1 per action: it loads and resumes under those
-    settings (robostrich-evaluate, --resume) and is refused under today's defaults."""
-    from agents import evaluation
+def test_checkpoint_of_another_format_version_or_missing_a_field_is_refused_in_one_line(tmp_path):
+    """A checkpoint written by an older format (here version 1, its checksum intact) is refused with
+    one line naming its version and the one this code reads; a fingerprint without a config field
+    (written before the field existed) is refused naming the field, not filled in."""
+    import hashlib
+    import pickle
     plan = parse_plan("point_mass/easy:300")
-    legacy = SACConfig(**{**TINY.to_dict(), "hidden_sizes": (32, 32), "her_lessons": (),
-                          "target_entropy_per_action": -1.0})
-    run = CurriculumRun(plan, legacy, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300)
+    run = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300)
     run.run()
     payload = checkpoint.load(run.checkpoint_path)
-    old = run.fingerprint()
-    old["config"] = {k: v for k, v in old["config"].items() if k not in ("her_lessons", "target_entropy_per_action")}
-    path = str(tmp_path / "old.pkl")
-    checkpoint.save(path, payload, old)
-    loaded = evaluation.load_run_from_checkpoint(path)
-    assert loaded.config == legacy and loaded.config.resolved_target_entropy(2) == -2.0  # point_mass: |A| = 2
-    assert_same_run(loaded, run)
-    today = SACConfig(**{**TINY.to_dict(), "hidden_sizes": (32, 32)})  # -2 per action
-    with pytest.raises(ValueError, match=r"target_entropy_per_action: checkpoint has -1.0, this run has -2.0"):
-        CurriculumRun(plan, today, seed=0, run_dir=str(tmp_path / "b")).restore(path)
-
-
-def test_arm_checkpoint_from_before_failure_sampling_resumes_as_the_uniform_run_it_was(tmp_path):
-    """An arm run's fingerprint without target_sampling, fixed_stored_starts and the attitude-precision
-    weight (before the main job drew targets by failure, started lessons 1-2 at stored poses and
-    paid for a level head inside the tolerance) trained with the task's uniform draw, fixed starts
-    and no such term: it resumes with those and is refused under each of today's defaults, naming
-    the difference; a run whose task arguments leave them out resumes as itself; a dm_control
-    run's task arguments are left as they were."""
-    from agents.curriculum import upgrade_fingerprint
-    plan = parse_plan("robostrich/lesson1:300")
-    uniform = {"weights": {"position_precision": 1.0, "attitude_precision": 0.0}, "target_sampling": "uniform",
-               "fixed_stored_starts": 0.0}
-    config = SACConfig(**{**TINY.to_dict(), "hidden_sizes": (32, 32)})
-    run = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300,
-                        task_kwargs=uniform)
-    run.run()
-    old = run.fingerprint()
-    old["task_kwargs"] = {"weights": {"position_precision": 1.0}}
-    assert upgrade_fingerprint(old)["task_kwargs"] == uniform
-    path = str(tmp_path / "old.pkl")
-    checkpoint.save(path, checkpoint.load(run.checkpoint_path), old)
-    resumed = CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "b"), task_kwargs=uniform)
-    resumed.restore(path)
-    assert_same_run(resumed, run)
-    failures = {**uniform, "target_sampling": "failures"}
-    with pytest.raises(ValueError, match="target_sampling"):
-        CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "c"), task_kwargs=failures).restore(path)
-    with pytest.raises(ValueError, match="fixed_stored_starts: checkpoint has 0.0, this run has 0.25"):
-        CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "d"),
-                      task_kwargs={**uniform, "fixed_stored_starts": 0.25}).restore(path)
-    with pytest.raises(ValueError, match="attitude_precision"):
-        CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "f"),
-                      task_kwargs={**uniform, "weights": {"position_precision": 1.0, "attitude_precision": 0.5}}
-                      ).restore(path)
-    # leaving an argument out means the task's default, in the checkpoint and in this run alike
-    CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "e"),
-                  task_kwargs={"weights": {"position_precision": 1.0}}).restore(path)
-    dmc = {"plan": "reacher/easy:300", "task_kwargs": {"time_limit": 5}}
-    assert upgrade_fingerprint(dmc) == dmc
-    # An arm checkpoint that names no layout was trained on the tasks' routing of its day, now
-    # called ventral_from_base: today's default refuses it by name, that layout resumes it.
-    unnamed = {k: v for k, v in run.fingerprint().items() if k != "layout"}
-    assert run.fingerprint()["layout"] == "ventral_slips"
-    assert upgrade_fingerprint(unnamed)["layout"] == "ventral_from_base"
-    path = str(tmp_path / "unnamed.pkl")
-    checkpoint.save(path, checkpoint.load(run.checkpoint_path), unnamed)
-    with pytest.raises(ValueError, match="layout: checkpoint has 'ventral_from_base', this run has 'ventral_slips'"):
-        CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "g"), task_kwargs=uniform).restore(path)
-    CurriculumRun(plan, config, seed=0, run_dir=str(tmp_path / "h"), task_kwargs=uniform,
-                  layout="ventral_from_base").restore(path)
+    body = pickle.dumps({"format_version": 1, "fingerprint": run.fingerprint(), "payload": payload})
+    old = tmp_path / "v1.pkl"
+    old.write_bytes(checkpoint.MAGIC + hashlib.sha256(body).digest() + body)
+    with pytest.raises(checkpoint.CheckpointError) as refused:
+        DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "b")).restore(str(old))
+    message = str(refused.value)
+    assert "format version 1" in message and f"reads version {checkpoint.FORMAT_VERSION}" in message
+    assert "\n" not in message and checkpoint.FORMAT_VERSION == 2
+    lacking = run.fingerprint()
+    lacking["config"] = {k: v for k, v in lacking["config"].items() if k != "her_lessons"}
+    checkpoint.save(str(tmp_path / "lacking.pkl"), payload, lacking)
+    with pytest.raises(ValueError, match=r"her_lessons: checkpoint has '<missing>'"):
+        DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "c")).restore(str(tmp_path / "lacking.pkl"))
+    DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "d")).restore(run.checkpoint_path)  # its own: fine
 
 
 def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
     plan = parse_plan("point_mass/easy:500,point_mass/hard:500")
-    run = CurriculumRun(plan, TINY, seed=2, run_dir=str(tmp_path), checkpoint_every=10_000)
+    run = DomainRun(plan, TINY, seed=2, run_dir=str(tmp_path), checkpoint_every=10_000)
     seen = {}
 
     def on_eval(r):  # called right after the switch to lesson 2
@@ -193,14 +147,14 @@ def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
     assert run.loop.learner is seen["learner"] and run.loop.learner.num_updates > seen["updates"]
     # lesson 2 starts from lesson 1's trained parameters, not a fresh initialisation
     assert any(not np.array_equal(x, y) for x, y in zip(seen["policy"], initial))
-    fresh = CurriculumRun(plan[1:], TINY, seed=2, run_dir=str(tmp_path / "fresh"))
+    fresh = DomainRun(plan[1:], TINY, seed=2, run_dir=str(tmp_path / "fresh"))
     assert any(not np.array_equal(x, y) for x, y in zip(seen["policy"], leaves(fresh.loop.learner.policy_params)))
     assert float(np.exp(run.loop.learner.state.log_alpha)) != TINY.init_temperature
 
 
 def test_action_repeat_holds_actions_and_sums_rewards(tmp_path):
     config = SACConfig(**{**TINY.to_dict(), "action_repeat": 3, "hidden_sizes": (32, 32)})
-    run = CurriculumRun(parse_plan("point_mass/easy:1000"), config, seed=0, run_dir=str(tmp_path))
+    run = DomainRun(parse_plan("point_mass/easy:1000"), config, seed=0, run_dir=str(tmp_path))
     episodes = []
     ran = run.loop.run(1000, on_episode=episodes.append)
     assert ran == 1000 and run.loop.env_steps == 1000  # the episode end cuts the last repeat short
@@ -236,7 +190,7 @@ def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
     assert default == SACConfig()  # the CLI's defaults are the dataclass's, under the main job's on robostrich
     arm = training.config_from_args(training.build_parser().parse_args([]), [])
     assert arm == SACConfig(**training.MAIN_JOB_CONFIG["robostrich"])
-    argv = ["--her-ratio", "0.5", "--her-lessons", "lesson1,lesson2", "--hidden", "32,16"]
+    argv = ["--her-ratio", "0.5", "--her-lessons", "lesson1,lesson2", "--hidden-sizes", "32,16"]
     config = training.config_from_args(training.build_parser().parse_args(argv), argv)
     assert config.her_lessons == ("lesson1", "lesson2") and config.hidden_sizes == (32, 16)
     assert (config.her_ratio_in_lesson("lesson2"), config.her_ratio_in_lesson("lesson3")) == (0.5, 0.0)
@@ -245,7 +199,7 @@ def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
 def test_lesson_checkpoints_hold_the_policy_after_each_lesson(tmp_path):
     """--keep-lesson-checkpoints writes RUN/after_lessonK.pkl at the end of every lesson but the
     last: a whole checkpoint of that moment, which robostrich-evaluate's loader restores."""
-    from agents import evaluation
+    from agents.robostrich import evaluation
     args = TINY_ARGS[:-1] + ["--plan", "point_mass/easy:300,point_mass/hard:300", "--no-baseline",
                              "--checkpoint-every", "1000", "--keep-lesson-checkpoints",
                              "--out", str(tmp_path)]
@@ -266,7 +220,7 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     """The defaults are the measured recipe (docs/learning.md) on the arm domains: antagonist_pairs,
     -2 entropy per tendon, HER in lesson 1, the precision term; dm_control plans get none of the
     arm's settings, and the paper's routing and eq. 10 stay one flag away."""
-    from agents.domains import Domain
+    from agents.robostrich.domains import Domain
     arm, dmc = Domain("robostrich"), Domain("reacher")
     config = SACConfig()
     assert config.resolved_target_entropy(9) == -18.0 and SACConfig.paper_sac().resolved_target_entropy(9) == -9.0
@@ -321,8 +275,8 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
     import dataclasses
     plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
     long = dataclasses.replace(TINY, long_horizon_lessons=("hard",), long_horizon_discount=0.9)
-    plain = CurriculumRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
-    other = CurriculumRun(plan, long, seed=0, run_dir=str(tmp_path / "long"), checkpoint_every=600)
+    plain = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
+    other = DomainRun(plan, long, seed=0, run_dir=str(tmp_path / "long"), checkpoint_every=600)
     assert other.loop.learner.config.discount == 0.99
     for run in (plain, other):
         with pytest.raises(TrainingInterrupted):
@@ -332,7 +286,7 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
     plain.run()
     with pytest.raises(TrainingInterrupted):
         other.run(stop_at_step=600)
-    resumed = CurriculumRun(plan, long, seed=0, run_dir=str(tmp_path / "long"))
+    resumed = DomainRun(plan, long, seed=0, run_dir=str(tmp_path / "long"))
     resumed.restore()
     assert resumed.loop.learner.config.discount == 0.9
     other.run()
@@ -342,7 +296,7 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
                                                         leaves(other.loop.learner.state.q_params))]
     assert all(differs)
     with pytest.raises(ValueError, match=r"long_horizon_lessons names \['lesson3'\]"):
-        CurriculumRun(plan, dataclasses.replace(TINY, long_horizon_lessons=("lesson3",)), seed=0,
+        DomainRun(plan, dataclasses.replace(TINY, long_horizon_lessons=("lesson3",)), seed=0,
                       run_dir=str(tmp_path / "bad"))
     with pytest.raises(ValueError, match="long_horizon_discount must be in"):
         dataclasses.replace(TINY, long_horizon_discount=1.5)
@@ -358,8 +312,8 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
     explore = dataclasses.replace(TINY, exploration_lessons=("hard",), exploration_target_entropy_per_action=1.0,
                                   exploration_noise_correlation=0.9)
-    plain = CurriculumRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
-    other = CurriculumRun(plan, explore, seed=0, run_dir=str(tmp_path / "explore"), checkpoint_every=600)
+    plain = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
+    other = DomainRun(plan, explore, seed=0, run_dir=str(tmp_path / "explore"), checkpoint_every=600)
     actions = other.loop.learner.networks.action_size
     assert other.loop.learner.config.resolved_target_entropy(actions) == -2.0 * actions
     for run in (plain, other):
@@ -371,7 +325,7 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     plain.run()
     with pytest.raises(TrainingInterrupted):
         other.run(stop_at_step=600)
-    resumed = CurriculumRun(plan, explore, seed=0, run_dir=str(tmp_path / "explore"))
+    resumed = DomainRun(plan, explore, seed=0, run_dir=str(tmp_path / "explore"))
     resumed.restore()
     assert resumed.loop.learner.config.resolved_target_entropy(actions) == 1.0 * actions
     assert resumed.loop.actor.noise_correlation == 0.9 and plain.loop.actor.noise_correlation == 0.0
@@ -385,7 +339,7 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     # Over the second lesson the plain run's temperature keeps falling, the explorer's turns up.
     assert temperature["explore"] > at_switch > temperature["plain"], (at_switch, temperature)
     with pytest.raises(ValueError, match=r"exploration_lessons names \['lesson3'\]"):
-        CurriculumRun(plan, dataclasses.replace(TINY, exploration_lessons=("lesson3",)), seed=0,
+        DomainRun(plan, dataclasses.replace(TINY, exploration_lessons=("lesson3",)), seed=0,
                       run_dir=str(tmp_path / "bad"))
     with pytest.raises(ValueError, match="exploration_target_entropy_per_action must be finite"):
         dataclasses.replace(TINY, exploration_target_entropy_per_action=float("nan"))

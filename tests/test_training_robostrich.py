@@ -4,8 +4,8 @@ import os
 
 import numpy as np
 
-from agents import evaluation
-from agents.curriculum import CurriculumRun, parse_plan
+from agents.robostrich import evaluation
+from agents.robostrich.runs import DomainRun, parse_plan
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 
@@ -30,7 +30,7 @@ def position_report(run):
 
 
 def test_short_lesson1_training_improves_success_on_heldout_targets(tmp_path):
-    run = CurriculumRun(parse_plan(f"robostrich/lesson1:{STEPS}"), CONFIG, seed=0, run_dir=str(tmp_path))
+    run = DomainRun(parse_plan(f"robostrich/lesson1:{STEPS}"), CONFIG, seed=0, run_dir=str(tmp_path))
     untrained_success, untrained_error = position_report(run)
     run.run()
     trained_success, trained_error = position_report(run)
@@ -39,10 +39,10 @@ def test_short_lesson1_training_improves_success_on_heldout_targets(tmp_path):
 
 
 def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them(tmp_path, verify_rrd):
-    from agents import training
+    from agents.robostrich import training
     out = str(tmp_path / "run")
-    training.main(["--out", out, "--plan", "lesson1:250,lesson2:250,lesson3:250", "--hidden", "32,32",
-                   "--batch-size", "32", "--min-replay", "100", "--checkpoint-every", "300",
+    training.main(["--out", out, "--plan", "lesson1:250,lesson2:250,lesson3:250", "--hidden-sizes", "32,32",
+                   "--batch-size", "32", "--min-replay-size", "100", "--checkpoint-every", "300",
                    "--num-eval-targets", "2", "--final-eval-targets", "2", "--quiet"])
     for name in ("config.json", "summary.json", "training.rrd", "figures/learning_curves.png", "figures/track.png",
                  "curriculum/checkpoint.pkl", "baseline/checkpoint.pkl", "curriculum/metrics.jsonl",

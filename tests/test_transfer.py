@@ -1,4 +1,4 @@
-"""robostrich-train --init-from: an a1 run starts from a checkpoint of the arm on its frame (agents/transfer.py).
+"""robostrich-train --init-from: an a1 run starts from a checkpoint of the arm on its frame (agents/robostrich/transfer.py).
 
 Real JAX and MuJoCo at tiny sizes: a 300-step robostrich run gives the checkpoint.
 """
@@ -12,14 +12,15 @@ import robostrich_suite
 from robostrich_suite.model import quadruped as quad
 from robostrich_suite.tasks import quadruped_tasks
 
-from agents import checkpoint, transfer
-from agents.curriculum import CurriculumRun, parse_plan
+from agents import checkpoint
+from agents.robostrich import transfer
+from agents.robostrich.runs import DomainRun, parse_plan
 from agents.sac.config import SACConfig
 from test_cli import assert_succeeded, assert_user_error, call, finish, start
 
 TINY = SACConfig(hidden_sizes=(16, 16), batch_size=16, min_replay_size=50, max_replay_size=2000,
                  updates_per_call=2, env_steps_per_call=2)
-TINY_ARGS = ["--hidden", "16,16", "--batch-size", "16", "--min-replay", "50", "--replay-size", "2000",
+TINY_ARGS = ["--hidden-sizes", "16,16", "--batch-size", "16", "--min-replay-size", "50", "--max-replay-size", "2000",
              "--updates-per-call", "2", "--env-steps-per-call", "2", "--num-eval-targets", "1",
              "--final-eval-targets", "1", "--quiet", "--no-rerun", "--no-figures"]
 A1_PLAN = parse_plan("robostrich_a1/lesson2:100")
@@ -28,7 +29,7 @@ A1_PLAN = parse_plan("robostrich_a1/lesson2:100")
 @pytest.fixture(scope="module")
 def source(tmp_path_factory):
     """A trained robostrich run (temperature and Adam moments moved off their start) and its checkpoint."""
-    run = CurriculumRun(parse_plan("robostrich/lesson2:300"), TINY, 0, str(tmp_path_factory.mktemp("source")),
+    run = DomainRun(parse_plan("robostrich/lesson2:300"), TINY, 0, str(tmp_path_factory.mktemp("source")),
                         checkpoint_every=10 ** 6)
     run.run()
     assert run.loop.learner.num_updates > 0
@@ -37,7 +38,7 @@ def source(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def transferred(source, tmp_path_factory):
-    run = CurriculumRun(A1_PLAN, TINY, 1, str(tmp_path_factory.mktemp("a1")))
+    run = DomainRun(A1_PLAN, TINY, 1, str(tmp_path_factory.mktemp("a1")))
     transfer.initialize(run, source[1])
     return run
 
@@ -161,11 +162,11 @@ def test_checkpoints_that_cannot_start_the_run_are_refused(source, tmp_path):
     (tmp_path / "junk.pkl").write_bytes(b"not a checkpoint")
     with pytest.raises(checkpoint.CheckpointError):
         transfer.check_source(str(tmp_path / "junk.pkl"), A1_PLAN, TINY)
-    fresh = CurriculumRun(A1_PLAN, TINY, 1, str(tmp_path / "a1"))
+    fresh = DomainRun(A1_PLAN, TINY, 1, str(tmp_path / "a1"))
     with pytest.raises(transfer.TransferError, match="has changed"):
         transfer.initialize(fresh, path, digest="0" * 64)
     # The same domain with the same layout: a plain copy of the learner.
-    same = CurriculumRun(parse_plan("robostrich/lesson3:100"), TINY, 5, str(tmp_path / "same"))
+    same = DomainRun(parse_plan("robostrich/lesson3:100"), TINY, 5, str(tmp_path / "same"))
     transfer.initialize(same, path)
     for a, b in zip(jax.tree_util.tree_leaves(same.loop.learner.state[:7]),
                     jax.tree_util.tree_leaves(run.loop.learner.state[:7])):
@@ -197,7 +198,7 @@ def test_a_target_that_keeps_a_policy_average_starts_it_at_the_source_s(source, 
     import dataclasses
     source_state = jax.tree_util.tree_map(np.asarray, source[0].loop.learner.state)
     assert source_state.average_policy_params is not None  # TINY keeps the default average
-    run = CurriculumRun(A1_PLAN, dataclasses.replace(TINY, policy_average=0.01), 1, str(tmp_path))
+    run = DomainRun(A1_PLAN, dataclasses.replace(TINY, policy_average=0.01), 1, str(tmp_path))
     obs_map = transfer.ObservationMap.between(source[0].loop.flattener.describe(), run.loop.flattener.describe(),
                                               *transfer.correspondence("robostrich", "robostrich_a1"))
     fresh = run.loop.learner.get_state()

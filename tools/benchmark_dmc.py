@@ -49,7 +49,7 @@ def build_parser():
     p.add_argument("--out", default="runs/dmc", help="writes dmc.json, dmc.md and one directory per run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     g = p.add_argument_group("SAC")
-    g.add_argument("--hidden", default="256,256")
+    g.add_argument("--hidden-sizes", default="256,256")
     g.add_argument("--batch-size", type=int, default=256)
     # A critic that learns fast: lr 1e-3, layer-normalised critics, two updates per transition
     # (Acme's 3e-4, no normalisation and one update reached 445 on reacher/easy at 100k, this 907;
@@ -59,7 +59,7 @@ def build_parser():
     g.add_argument("--updates-per-call", type=int, default=16, help="gradient steps per learner call (default: "
                    "%(default)s, two per transition with --env-steps-per-call 8)")
     g.add_argument("--env-steps-per-call", type=int, default=8, help="agent steps (transitions) between learner calls")
-    g.add_argument("--min-replay", type=int, default=5000, help="transitions (agent steps) of uniform actions first")
+    g.add_argument("--min-replay-size", type=int, default=5000, help="transitions (agent steps) of uniform actions first")
     g.add_argument("--init-temperature", type=float, default=0.01,
                    help="initial entropy temperature (Acme: 1; default: the arm agent's %(default)s)")
     g.add_argument("--target-entropy-per-action", type=float, default=-1.0,
@@ -132,18 +132,18 @@ def format_table(rows) -> str:
 
 
 def write_atomic(path: str, text: str) -> None:
-    from agents.evaluation import write_text  # the project's one atomic writer
+    from agents.robostrich.evaluation import write_text  # the project's one atomic writer
     write_text(path, text)
 
 
 def train_and_evaluate(task, seed, steps, eval_at, config, args, progress, on_row):
     """One SAC run on `task`; `on_row(row)` after each deterministic evaluation."""
-    from agents import evaluation
-    from agents.curriculum import CurriculumRun, parse_plan
+    from agents.robostrich import evaluation
+    from agents.robostrich.runs import DomainRun, parse_plan
     from agents.sac.builder import SACBuilder
     domain, task_name = task.split("/")
     run_dir = os.path.join(args.out, task.replace("/", "_"), f"seed_{seed}")
-    run = CurriculumRun(parse_plan(f"{task}:{steps}"), config, seed, run_dir, checkpoint_every=steps, name=task)
+    run = DomainRun(parse_plan(f"{task}:{steps}"), config, seed, run_dir, checkpoint_every=steps, name=task)
     for path in (run.metrics_path, run.evals_path):  # a fresh run: no records of an earlier one
         if os.path.exists(path):
             os.unlink(path)
@@ -178,8 +178,8 @@ def main(argv=None) -> int:
         settings = {t: task_settings(args, t) for t in tasks}
         from agents.sac.config import SACConfig
         configs = {t: SACConfig(batch_size=args.batch_size, learning_rate=args.learning_rate,
-                                hidden_sizes=tuple(int(h) for h in args.hidden.split(",") if h),
-                                min_replay_size=args.min_replay, updates_per_call=args.updates_per_call,
+                                hidden_sizes=tuple(int(h) for h in args.hidden_sizes.split(",") if h),
+                                min_replay_size=args.min_replay_size, updates_per_call=args.updates_per_call,
                                 env_steps_per_call=args.env_steps_per_call, action_repeat=settings[t][1],
                                 critic_layer_norm=args.critic_layer_norm, init_temperature=args.init_temperature,
                                 target_entropy_per_action=args.target_entropy_per_action,

@@ -1,6 +1,6 @@
 """Speed of the learner and the environment loop, as ratios against plain versions measured in the same run.
 
-    PYTHONPATH=. python tools/benchmark_learner.py [--domain robostrich --task lesson1] [--hidden 256,256 --batch 256]
+    PYTHONPATH=. python tools/benchmark_learner.py [--domain robostrich --task lesson1] [--hidden-sizes 256,256 --batch 256]
 
 Learner: updates/s of the jitted `lax.scan` update (agents.sac.learning) against
   (a) a plain SAC update written CleanRL-style: each loss jitted on its own,
@@ -26,7 +26,7 @@ import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 import optax  # noqa: E402
 
-from agents.curriculum import make_environment  # noqa: E402
+from agents.robostrich.runs import make_environment  # noqa: E402
 from agents.sac.builder import SACBuilder  # noqa: E402
 from agents.sac.config import SACConfig  # noqa: E402
 from agents.sac.learning import SACLearner, Transitions, init_state  # noqa: E402
@@ -115,14 +115,14 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--domain", default="robostrich")
     p.add_argument("--task", default="lesson1")
-    p.add_argument("--hidden", default="256,256")
+    p.add_argument("--hidden-sizes", default="256,256")
     p.add_argument("--batch", type=int, default=256)
     p.add_argument("--updates-per-call", type=int, default=8)
     p.add_argument("--seconds", type=float, default=4.0, help="measuring time per variant (split in rounds)")
     p.add_argument("--action-repeat", type=int, default=5)
     args = p.parse_args(argv)
     env = make_environment(args.domain, args.task, 0)
-    config = SACConfig(batch_size=args.batch, hidden_sizes=tuple(int(h) for h in args.hidden.split(",")),
+    config = SACConfig(batch_size=args.batch, hidden_sizes=tuple(int(h) for h in args.hidden_sizes.split(",")),
                        updates_per_call=args.updates_per_call, min_replay_size=0,
                        # the same computation as the plain implementation it is compared with
                        critic_layer_norm=False, her_ratio=0.0, relabel_rewards=False)

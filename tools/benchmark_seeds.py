@@ -38,7 +38,7 @@ def parse_seeds(text: str):
 
 def build_parser():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False,
-                                epilog="Other arguments are passed to robostrich-train (agents/training.py).")
+                                epilog="Other arguments are passed to robostrich-train (agents/robostrich/training.py).")
     p.add_argument("--seeds", type=parse_seeds, default=[0, 1, 2], help="comma-separated seeds (default 0,1,2)")
     p.add_argument("--out", default="runs/seeds", help="benchmark directory; seed K trains into OUT/seed_K")
     return p
@@ -55,7 +55,7 @@ def _stats(values):
 def aggregate(summaries, seeds=None, minutes=None) -> dict:
     """Mean, min and max over seeds of each run's evaluation metrics.
 
-    `summaries` are the seeds' summary.json dicts (agents/training.py: summary["runs"][label][kind]);
+    `summaries` are the seeds' summary.json dicts (agents/robostrich/training.py: summary["runs"][label][kind]);
     `seeds` and `minutes` (wall-clock per seed, None where unknown) go into the result as given.
     """
     if not summaries:
@@ -110,13 +110,13 @@ def _join(values):
 
 
 def write_atomic(path: str, text: str) -> None:
-    from agents.evaluation import write_text  # the project's one atomic writer
+    from agents.robostrich.evaluation import write_text  # the project's one atomic writer
     write_text(path, text)
 
 
 def run_seed(seed: int, seed_dir: str, passthrough) -> float:
     """Train one seed (resuming its checkpoints if any); returns wall-clock minutes."""
-    from agents import training
+    from agents.robostrich import training
     has_checkpoint = any(os.path.exists(os.path.join(seed_dir, label, "checkpoint.pkl"))
                          for label in ("curriculum", "baseline"))
     argv = list(passthrough) + ["--seed", str(seed), "--out", seed_dir]

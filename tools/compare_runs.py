@@ -20,8 +20,8 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 import benchmark_seeds  # noqa: E402  (tools/, beside this script)
-from agents import figures  # noqa: E402
-from agents.curriculum import parse_plan  # noqa: E402
+from agents.robostrich import figures  # noqa: E402
+from agents.robostrich.runs import parse_plan  # noqa: E402
 
 KINDS = ("heldout", "heldout_moving")
 

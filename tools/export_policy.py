@@ -13,7 +13,7 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
-from agents.policy_export import export_policy  # noqa: E402
+from agents.robostrich.policy_export import export_policy  # noqa: E402
 from robostrich_suite import cli as cli_lib  # noqa: E402
 
 

@@ -3,7 +3,7 @@
     python tools/input_sensitivity.py [--errors 0,0.01,0.03,0.1] [--every 4] [--draws 3] [--out runs/sensitivity]
 
 For every `--every`-th training target, the stored input that holds the head there (the
-lookup table, agents/lookup.py) is held for one `lesson2` episode from the fixed start, with a
+lookup table, agents/robostrich/lookup.py) is held for one `lesson2` episode from the fixed start, with a
 constant Gaussian error added to each tendon (standard deviation = a fraction of that tendon's
 half-range), `--draws` times per error size.  Success is the task's (0.05 m, 5 deg at the episode's
 end).  It tells what an agent that outputs absolute inputs must achieve: why a policy network whose
@@ -43,8 +43,8 @@ def build_parser():
 def measure(errors, every: int = 4, draws: int = 3, seed: int = 0) -> list:
     """One row per error size: episodes, success rate, median and 90th-percentile errors."""
     import robostrich_suite
-    from agents import probes
-    from agents.lookup import lookup_table, nearest
+    from agents.robostrich import probes
+    from agents.robostrich.lookup import lookup_table, nearest
     from robostrich_suite import targets
     from tqdm import tqdm
 
@@ -96,7 +96,7 @@ def markdown(rows) -> str:
 
 def main(argv=None):
     args = build_parser().parse_args(argv)
-    from agents import evaluation
+    from agents.robostrich import evaluation
     rows = measure(args.errors, args.every, args.draws, args.seed)
     os.makedirs(args.out, exist_ok=True)
     evaluation.write_json(os.path.join(args.out, "sensitivity.json"), rows)

@@ -20,15 +20,16 @@ class SACBuilder:
     def __init__(self, config: SACConfig):
         self.config = config
 
-    def make_adapter(self, env, flattener, lookup_table=None) -> ActionAdapter:
-        """Policy box [-1, 1]^|A| <-> the environment's actions; a residual on the lookup if configured.
-        `lookup_table`: the residual's base (agents/lookup.py; default: the paper layout's poses)."""
+    def make_adapter(self, env, flattener, base_policy=None) -> ActionAdapter:
+        """Policy box [-1, 1]^|A| <-> the environment's actions; with ``config.residual_scale`` > 0 a
+        residual on ``base_policy(flattener)``, a callable from a flat observation to an action."""
         action_spec = env.action_spec()
         if len(action_spec.shape) != 1:
             raise ValueError(f"expected a flat action spec, got shape {action_spec.shape}")
         if self.config.residual_scale > 0:
-            from agents.lookup import LookupPolicy
-            return ResidualAdapter(action_spec, LookupPolicy(flattener, lookup_table), self.config.residual_scale)
+            if base_policy is None:
+                raise ValueError("residual_scale > 0 needs a base policy to add the residual to")
+            return ResidualAdapter(action_spec, base_policy(flattener), self.config.residual_scale)
         return ActionAdapter(action_spec)
 
     def make_networks(self, observation_size: int, action_size: int):
@@ -50,16 +51,18 @@ class SACBuilder:
     def make_actor(self, networks, adapter, params, key=None, deterministic: bool = False) -> Actor:
         return Actor(networks, adapter, params, key=key, deterministic=deterministic)
 
-    def make_components(self, env, seed: int, lookup_table=None) -> EnvironmentLoop:
-        """All of the above for `env`, wired into the loop that owns them (what a lesson plan runs)."""
+    def make_components(self, env, seed: int, base_policy=None, episode_probe=None) -> EnvironmentLoop:
+        """All of the above for `env`, wired into the loop that owns them (what a lesson plan runs);
+        ``episode_probe(env)``: metrics an episode's record gets from its last state."""
         flattener = ObservationFlattener(env.observation_spec())
-        adapter = self.make_adapter(env, flattener, lookup_table)
+        adapter = self.make_adapter(env, flattener, base_policy)
         networks = self.make_networks(flattener.size, adapter.size)
         learner_key, actor_key = jax.random.split(jax.random.PRNGKey(seed))
         learner = self.make_learner(networks, learner_key)
         replay = self.make_replay(env, flattener, adapter.size, seed)
         actor = self.make_actor(networks, adapter, learner.policy_params, key=actor_key)
-        return EnvironmentLoop(env, actor, replay, learner, self.config, flattener, seed=seed)
+        return EnvironmentLoop(env, actor, replay, learner, self.config, flattener, seed=seed,
+                               episode_probe=episode_probe)
 
     @staticmethod
     def make_eval_actor(loop: EnvironmentLoop) -> Actor:

@@ -65,7 +65,7 @@ class SACConfig:
     # Lessons that train toward `exploration_target_entropy_per_action` x |A| instead of the
     # target entropy above (empty: none): wider noise for a manoeuvre the policy's narrow noise
     # never tries (uncurling the neck through a whole turn), or narrower noise where precision
-    # matters more than search (the main job's lesson 3 on robostrich: agents/training.py).
+    # matters more than search (the main job's lesson 3 on robostrich: agents/robostrich/training.py).
     exploration_lessons: Tuple[str, ...] = ()
     exploration_target_entropy_per_action: float = -1.0
     # ... and explore there with noise correlated over control steps (AR(1) coefficient per step
@@ -76,7 +76,7 @@ class SACConfig:
     # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
     # replay then carry lesson-2 rewards instead of the ones they were collected with.
     relabel_rewards: bool = True
-    # Residual policy on the lookup baseline (agents/lookup.py) on tasks with a target_position
+    # Residual policy on the lookup baseline (agents/robostrich/lookup.py) on tasks with a target_position
     # observation: the action is the lookup's stored input plus this fraction of each tendon's
     # half-range times the policy's output (0 = off: the policy outputs the whole input).
     residual_scale: float = 0.0
@@ -106,11 +106,6 @@ class SACConfig:
     # plain EMA.  From 100k updates on the rate is policy_average itself (the arm's 479k-update runs).
     policy_average_fraction: float = 0.1
 
-    # What a field was, in effect, for checkpoints written before it existed: their fingerprints
-    # lack it, and `from_dict` fills it in so that they still load, resume and compare equal.
-    LEGACY_VALUES: ClassVar[dict] = {"her_lessons": (), "target_entropy_per_action": -1.0,
-                                     "her_level_goals": False, "policy_average": 0.0,
-                                     "policy_average_fraction": 0.0, "pre_tanh_penalty": 0.0}
     # Fields that name lesson tasks (tuples here, lists in a fingerprint).
     LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons", "exploration_lessons")
 
@@ -242,7 +237,6 @@ class SACConfig:
         unknown = set(d) - fields
         if unknown:
             raise ValueError(f"unknown SACConfig fields: {sorted(unknown)}")
-        d = {**{k: v for k, v in cls.LEGACY_VALUES.items() if k not in d}, **d}
         for name in ("hidden_sizes", *cls.LESSON_LIST_FIELDS):
             if name in d:
                 d[name] = tuple(d[name])

@@ -27,8 +27,7 @@ class TrainingState(NamedTuple):
     alpha_opt_state: tuple
     key: jnp.ndarray
     steps: jnp.ndarray  # number of gradient updates done
-    # Exponential moving average of policy_params (SACConfig.policy_average > 0), else None;
-    # a default so that checkpoints written before it existed still unpickle.
+    # Exponential moving average of policy_params (SACConfig.policy_average > 0), else None.
     average_policy_params: Optional[dict] = None
 
 

@@ -114,10 +114,10 @@ def movement_ratio(case: Case) -> dict:
 
 
 def heldout_success(case: Case, heldout: np.ndarray, make_actor, seed: int = 10_000) -> dict:
-    """``agents.evaluation``'s held-out summary on the case's arm: one lesson-2 episode
+    """``agents.robostrich.evaluation``'s held-out summary on the case's arm: one lesson-2 episode
     from the fixed start per target.  ``make_actor(flattener)`` gives the policy."""
     import robostrich_suite
-    from agents import evaluation
+    from agents.robostrich import evaluation
     from agents.replay import ObservationFlattener
     env = robostrich_suite.load("robostrich", evaluation.default_heldout_task("robostrich", "lesson3"),
                                 task_kwargs=dict(random=seed, arm_spec=case.spec,
@@ -133,7 +133,7 @@ def heldout_success(case: Case, heldout: np.ndarray, make_actor, seed: int = 10_
 
 def lookup_success(case: Case, target_path: pathlib.Path) -> dict:
     """The lookup baseline on the case's own targets (its table keeps no held-out pose)."""
-    from agents.lookup import LookupPolicy, lookup_table
+    from agents.robostrich.lookup import LookupPolicy, lookup_table
     heldout = targets.heldout_targets(target_path)
     table = lookup_table(targets.level_head_poses(target_path), heldout)
     return heldout_success(case, heldout, lambda flattener: LookupPolicy(flattener, table))
@@ -143,10 +143,10 @@ def curriculum_success(case: Case, target_path: pathlib.Path, steps: int, seed: 
                        run_dir: pathlib.Path) -> dict:
     """A short curriculum (lessons 1-3 in equal parts, ``robostrich-train``'s learner and
     defaults) on the case's own training targets, then its held-out success."""
-    from agents.curriculum import CurriculumRun, make_environment, parse_plan
+    from agents.robostrich.runs import DomainRun, make_environment, parse_plan
     from agents.sac.builder import SACBuilder
     from agents.sac.config import SACConfig
-    from agents.training import FIXED_START_ARM_TASK_KWARGS
+    from agents.robostrich.training import FIXED_START_ARM_TASK_KWARGS
     arm_kwargs = dict(arm_spec=case.spec, tendon_layout=case.layout,
                       target_pool=targets.training_targets(target_path))
 
@@ -155,7 +155,7 @@ def curriculum_success(case: Case, target_path: pathlib.Path, steps: int, seed: 
 
     per_lesson = max(steps // 3, 1)
     plan = parse_plan(",".join(f"lesson{i}:{per_lesson}" for i in (1, 2, 3)))
-    run = CurriculumRun(plan, SACConfig(), seed, str(run_dir), checkpoint_every=10 ** 9,
+    run = DomainRun(plan, SACConfig(), seed, str(run_dir), checkpoint_every=10 ** 9,
                         env_factory=env_factory, name=case.label, task_kwargs=FIXED_START_ARM_TASK_KWARGS)
     run.run()
     actor = SACBuilder.make_eval_actor(run.loop)

@@ -1,6 +1,6 @@
 """PNG figures of the application evaluations, as the paper's Fig. 9 and Fig. 12 (matplotlib, Agg).
 
-Both take the reports of agents/stabilization.py / agents/gap.py (label -> report with a
+Both take the reports of agents/robostrich/stabilization.py / agents/robostrich/gap.py (label -> report with a
 seed-0 `series`) and draw one line per policy; they return the Figure and write it when
 given a path.
 """
@@ -108,7 +108,7 @@ def gap_figure(reports: dict, scene: dict, targets, position_tolerance: float,
                          fontsize=8)
     for i, (label, report) in enumerate(reports.items()):
         s, color = report["series"], _color(label, i)
-        from agents.gap import position_error
+        from agents.robostrich.gap import position_error
         path_ax.plot(s["head_x"], s["head_z"], color=color, lw=1.0, label=label)
         error_ax.plot(s["time"], position_error(s), color=color, lw=1.0, label=label)
         attitude_ax.plot(s["time"], s["attitude"], color=color, lw=1.0, label=label)

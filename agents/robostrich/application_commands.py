@@ -13,7 +13,7 @@ import os
 
 import numpy as np
 
-from agents import applications
+from agents.robostrich import applications
 
 
 def _parser(description: str, out: str) -> argparse.ArgumentParser:
@@ -56,7 +56,7 @@ def _meta(args, task: str, policies) -> dict:
 
 
 def _write(out: str, name: str, report: dict, series: dict, table: str) -> list:
-    from agents.evaluation import write_json, write_text
+    from agents.robostrich.evaluation import write_json, write_text
     paths = [os.path.join(out, f"{name}_report.json"), os.path.join(out, f"{name}_series.json"),
              os.path.join(out, f"{name}_summary.txt")]
     write_json(paths[0], report)
@@ -89,7 +89,7 @@ def _split_series(results: dict) -> tuple:
 
 # --- head_stabilize ---------------------------------------------------------------------------
 def stabilization_table(results: dict, meta: dict) -> str:
-    from agents.stabilization import GOALS
+    from agents.robostrich.stabilization import GOALS
     lines = [f"head_stabilize on {meta['domain']}{' (layout ' + meta['layout'] + ')' if meta['layout'] else ''}, "
              f"{meta['seeds']} gait phases, scored from {meta['settled_from_s']} s; mean [worst] over the phases",
              f"{'policy':<10} {'height RMS':>14} {'height max':>14} {'head/trunk vz':>15} {'P_d mean err':>15} "
@@ -113,7 +113,7 @@ def stabilization_table(results: dict, meta: dict) -> str:
 
 
 def stabilize_main(argv=None) -> dict:
-    from agents import stabilization
+    from agents.robostrich import stabilization
     from robostrich_suite import cli as cli_lib
     parser = _parser("Head stabilisation while walking (Sec. 5.2.1, Fig. 9): head height, vertical velocity, "
                      "distance P_d and attitude of each policy over 12 s of walking with two trunk-height changes.",
@@ -140,7 +140,7 @@ def stabilize_main(argv=None) -> dict:
     table = stabilization_table(results, meta)
 
     def plot(arrays, path):
-        from agents import application_figures  # matplotlib only when a figure is drawn
+        from agents.robostrich import application_figures  # matplotlib only when a figure is drawn
         application_figures.stabilization_figure(arrays, path, args.settle)
     return _report(args, "stabilize", meta, results, series, table, policies, plot)
 
@@ -169,7 +169,7 @@ def gap_table(results: dict, meta: dict) -> str:
 
 
 def gap_main(argv=None) -> dict:
-    from agents import gap
+    from agents.robostrich import gap
     from robostrich_suite import cli as cli_lib
     from robostrich_suite.tasks import quadruped_tasks
     from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
@@ -204,7 +204,7 @@ def gap_main(argv=None) -> dict:
     table = gap_table(results, meta)
 
     def plot(arrays, path):
-        from agents import application_figures  # matplotlib only when a figure is drawn
+        from agents.robostrich import application_figures  # matplotlib only when a figure is drawn
         application_figures.gap_figure(arrays, gap.scene(), targets, tolerance, path)
     return _report(args, "gap", meta, results, series, table, policies, plot)
 

@@ -206,7 +206,7 @@ def _single_domain(plan, what: str) -> str:
 def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = None, record=None) -> InitSource:
     """Everything that can be checked before building the run: a readable checkpoint, of a domain that can
     start `plan`'s, with the same tendon layout and networks.  TransferError (FileNotFoundError) otherwise."""
-    from agents.curriculum import named_layout, parse_plan, upgrade_fingerprint
+    from agents.robostrich.runs import named_layout, parse_plan
     if record is None:
         record, digest = _read(path)
     else:
@@ -219,7 +219,7 @@ def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = Non
     source_domain = _single_domain(parse_plan(fingerprint["plan"]), f"the plan of {path}")
     target_domain = _single_domain(plan, "this run's plan")
     correspondence(source_domain, target_domain)
-    source_layout = upgrade_fingerprint(fingerprint).get("layout")
+    source_layout = fingerprint.get("layout")
     layout = named_layout(layout, plan)
     if source_layout != layout:
         raise TransferError(f"--init-from: {path} was trained with tendon layout {source_layout!r}, "

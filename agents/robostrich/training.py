@@ -24,11 +24,11 @@ from typing import Optional
 
 import numpy as np
 
-from agents import evaluation
-from agents.curriculum import (CurriculumRun, Lesson, check_lesson_names, format_plan, parse_plan, read_records,
-                               run_files, run_identity, upgrade_fingerprint)
-from agents.domains import Domain
-from agents.lookup import LABEL as LOOKUP_LABEL
+from agents.robostrich import evaluation
+from agents.curriculum import Lesson, format_plan, read_records, run_files
+from agents.robostrich.runs import DomainRun, check_lesson_names, parse_plan, run_identity
+from agents.robostrich.domains import Domain
+from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from robostrich_suite import cli as cli_lib
@@ -190,8 +190,8 @@ def build_parser():
                    help="start the curriculum's learner (policy, critics, target critics, optimiser states, "
                         "temperature) from a checkpoint.pkl of robostrich-train on the same domain or, for "
                         "--domain robostrich_a1, on robostrich (the arm on its frame): its networks are mapped "
-                        "onto the a1's observations (agents/transfer.py). Same tendon layout and networks "
-                        "(--hidden) required; the replay is not carried (other observations); the plain-SAC "
+                        "onto the a1's observations (agents/robostrich/transfer.py). Same tendon layout and networks "
+                        "(--hidden-sizes) required; the replay is not carried (other observations); the plain-SAC "
                         "baseline still starts from scratch, so the comparison shows what the transfer brings. "
                         "A --resume may leave it out (the checkpoint holds the transferred state)")
     p.add_argument("--task-kwargs", type=_json_object, default={},
@@ -228,14 +228,9 @@ def build_parser():
     return p
 
 
-# Older spellings kept for the fields whose flag was named before the CLI was generated.
-_FLAG_ALIASES = {"hidden_sizes": ("--hidden",), "min_replay_size": ("--min-replay",),
-                 "max_replay_size": ("--replay-size",)}
-
-
 def _config_flags(field_name: str) -> tuple:
-    """The flags of one SACConfig field: ``--field-name`` and any older spelling."""
-    return ("--" + field_name.replace("_", "-"),) + _FLAG_ALIASES.get(field_name, ())
+    """The flag of one SACConfig field: ``--field-name``."""
+    return ("--" + field_name.replace("_", "-"),)
 
 
 def _shown(value) -> str:
@@ -385,7 +380,7 @@ class RunJob:
 
 @dataclasses.dataclass(frozen=True)
 class RunSpec:
-    """Everything a CurriculumRun is built from (picklable): the parent process of a parallel
+    """Everything a DomainRun is built from (picklable): the parent process of a parallel
     job passes it to a worker instead of building the run (networks, replay, environment)
     itself, which it would only throw away."""
 
@@ -397,7 +392,7 @@ class RunSpec:
     checkpoint_every: int
     task_kwargs: Optional[dict]
     layout: Optional[str]
-    init_from: Optional[str] = None  # a checkpoint to start a fresh run's learner from (agents/transfer.py)
+    init_from: Optional[str] = None  # a checkpoint to start a fresh run's learner from (agents/robostrich/transfer.py)
     init_digest: Optional[str] = None  # its content hash, kept in the run's fingerprint
     keep_lesson_checkpoints: bool = False  # also a checkpoint after every lesson but the last
 
@@ -405,17 +400,17 @@ class RunSpec:
     def total_steps(self) -> int:
         return sum(l.steps for l in self.plan)
 
-    def build(self, restore: bool) -> CurriculumRun:
+    def build(self, restore: bool) -> DomainRun:
         """The run; restored from its checkpoint when ``restore`` and one exists (raises on a
         damaged or mismatched checkpoint, never restarts silently)."""
-        run = CurriculumRun(list(self.plan), self.config, self.seed, self.run_dir,
+        run = DomainRun(list(self.plan), self.config, self.seed, self.run_dir,
                             checkpoint_every=self.checkpoint_every, name=self.label,
                             task_kwargs=self.task_kwargs, layout=self.layout, init_from=self.init_digest,
                             keep_lesson_checkpoints=self.keep_lesson_checkpoints)
         if restore and os.path.exists(run.checkpoint_path):
             run.restore()
         elif self.init_from is not None:
-            from agents import transfer
+            from agents.robostrich import transfer
             transfer.initialize(run, self.init_from, self.init_digest)
         return run
 
@@ -433,7 +428,7 @@ class LookupSpec:
                                           job.final_eval_targets, record=job.record)
 
 
-def train_and_evaluate(run: CurriculumRun, job: RunJob, progress=None) -> dict:
+def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
     """Finish `run`'s plan (periodic held-out evaluations in its evals.jsonl), then its final
     evaluation (JSON reports in job.out_eval). Returns the reports and the run's counters."""
     config = run.config
@@ -451,7 +446,9 @@ def train_and_evaluate(run: CurriculumRun, job: RunJob, progress=None) -> dict:
                 f.write(json.dumps(record) + "\n")
 
         start, start_steps = time.time(), run.loop.env_steps
-        run.run(progress=progress, on_eval=on_eval, eval_at=job.eval_at, stop_at_step=job.stop_at_step)
+        with cli_lib.deferred_interrupts():  # Ctrl-C: a checkpoint between chunks, then KeyboardInterrupt
+            run.run(progress=progress, on_eval=on_eval, eval_at=job.eval_at, stop_at_step=job.stop_at_step,
+                    stop_requested=cli_lib.interrupted)
         timing = {"seconds": time.time() - start, "env_steps": run.loop.env_steps - start_steps,
                   "updates": run.loop.learner.num_updates}
     num_targets = job.final_eval_targets or (None if job.domain.is_arm else job.num_eval_targets)
@@ -614,23 +611,22 @@ def main(argv=None):
                                 "to start a fresh run")
     init = {}  # the curriculum's --init-from: (path, content hash)
     if args.init_from is not None:
-        from agents import transfer
+        from agents.robostrich import transfer
         source = transfer.check_source(args.init_from, plan, config, args.layout)
         init = {"init_from": source.path, "init_digest": source.digest}
     if args.resume:  # damaged or another configuration: refuse before building anything or touching a file
         from agents import checkpoint
         for label in existing:
             path = os.path.join(args.out, label, "checkpoint.pkl")
-            stored = upgrade_fingerprint(checkpoint.read_fingerprint(path))
+            stored = checkpoint.read_fingerprint(path)
             if label == "curriculum":  # a started run's learner is in its checkpoint: --init-from may be left out
                 if init and stored.get("init_from") != init["init_digest"]:
                     raise ValueError(f"{path} did not start from --init-from {args.init_from} "
                                      + ("(nor from any checkpoint)" if "init_from" not in stored else
                                         "(it started from another checkpoint, or that file has changed since)"))
                 init = {**init, "init_digest": stored["init_from"]} if "init_from" in stored else {}
-            expected = upgrade_fingerprint(run_identity(run_plans[label], config, args.seed, args.task_kwargs,
-                                                        args.layout,
-                                                        init.get("init_digest") if label == "curriculum" else None))
+            expected = run_identity(run_plans[label], config, args.seed, args.task_kwargs, args.layout,
+                                    init.get("init_digest") if label == "curriculum" else None)
             checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
             for records in run_files(os.path.join(args.out, label))[1:]:
                 read_records(records)  # a damaged line other than a torn last one, named
@@ -686,7 +682,7 @@ def main(argv=None):
     metrics = {label: read_jsonl(run_files(spec.run_dir)[1]) for label, spec in specs.items()}
     evals = {label: read_jsonl(run_files(spec.run_dir)[2]) for label, spec in specs.items()}
     if not args.no_figures:
-        from agents import figures
+        from agents.robostrich import figures
         os.makedirs(os.path.join(args.out, "figures"), exist_ok=True)
         figures.plot_learning_curves(metrics, evals, os.path.join(args.out, "figures", "learning_curves.png"),
                                      lesson_boundaries=boundaries[:-1],
@@ -695,7 +691,7 @@ def main(argv=None):
             figures.plot_track({l: f["track"] for l, f in finals.items()},
                                os.path.join(args.out, "figures", "track.png"))
     if not args.no_rerun:
-        from agents import recording
+        from agents.robostrich import recording
         recording.log_training_curves(os.path.join(args.out, "training.rrd"), metrics, evals)
     summary = {"runs": {label: {k: f[k]["summary"] for k in f} for label, f in finals.items()},
                "env_steps": {label: o["env_steps"] for label, o in outcomes.items()},

@@ -21,7 +21,7 @@ from typing import Optional
 import mujoco
 import numpy as np
 
-from agents import applications
+from agents.robostrich import applications
 
 TASK = "narrow_gap"
 OBSTACLE_PREFIX = "gap_"

@@ -6,9 +6,9 @@ its success, and writes the reports, a Rerun recording of `track` and the track 
 """
 import os
 
-from agents import evaluation, figures
-from agents.domains import TRACK_TASK, as_domain
-from agents.recording import RolloutRecorder
+from agents.robostrich import evaluation, figures
+from agents.robostrich.domains import TRACK_TASK, as_domain
+from agents.robostrich.recording import RolloutRecorder
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import policies
 

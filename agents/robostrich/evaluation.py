@@ -2,7 +2,7 @@
 
 On the arm every held-out target is tried from the fixed start (`heldout`) and
 from three poses where the arm holds another target (`heldout_moving`), and
-the no-learning `lookup` baseline (agents/lookup.py) is evaluated beside the
+the no-learning `lookup` baseline (agents/robostrich/lookup.py) is evaluated beside the
 agents.  Other dm_control domains report episode returns.  Writes one JSON
 report per evaluation. `main` (console command
 `robostrich-evaluate`) loads a checkpoint and writes the same reports,
@@ -17,9 +17,9 @@ from typing import Optional
 
 import numpy as np
 
-from agents import probes
-from agents.curriculum import make_environment
-from agents.domains import MOVING_START_TASK, TRACK_TASK, as_domain
+from agents.robostrich import probes
+from agents.robostrich.runs import make_environment
+from agents.robostrich.domains import MOVING_START_TASK, TRACK_TASK, as_domain
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, PRECISE_POSITION_TOLERANCE
 
@@ -238,7 +238,7 @@ def evaluate_agent(actor, flattener, out_dir: str, label: str, domain, heldout_t
     if track_task:
         recorder = None
         if record:
-            from agents.recording import RolloutRecorder
+            from agents.robostrich.recording import RolloutRecorder
             recorder = RolloutRecorder(os.path.join(out_dir, f"{label}_track.rrd"), name=f"{label} track")
         try:
             reports["track"] = evaluate_track(actor, flattener, domain, track_task, recorder=recorder,
@@ -272,7 +272,7 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
     domain = as_domain(domain)
     if not domain.is_arm:
         return None
-    from agents.lookup import LABEL, LookupPolicy
+    from agents.robostrich.lookup import LABEL, LookupPolicy
     from agents.replay import ObservationFlattener
     flattener = ObservationFlattener(make_environment(domain, heldout_task, 0).observation_spec())
     return evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain,
@@ -300,14 +300,14 @@ def _json_default(o):
 
 
 def checked_fingerprint(path: str) -> dict:
-    """The (upgraded) fingerprint of a robostrich-train checkpoint, after checking that it holds
+    """The fingerprint of a robostrich-train checkpoint, after checking that it holds
     what a run is rebuilt from: a CheckpointError naming what it lacks, before anything is built."""
     from agents import checkpoint
-    from agents.curriculum import CurriculumRun, upgrade_fingerprint
+    from agents.robostrich.runs import DomainRun
     record, _ = checkpoint.read_with_digest(path)
-    fp = upgrade_fingerprint(record["fingerprint"])
+    fp = record["fingerprint"]
     missing = ([k for k in ("plan", "config", "seed") if k not in fp]
-               + [k for k in CurriculumRun.STATE_FIELDS if k not in record["payload"]])
+               + [k for k in DomainRun.STATE_FIELDS if k not in record["payload"]])
     if missing:
         raise checkpoint.CheckpointError(f"{path} is not a whole robostrich-train checkpoint: it lacks {missing}")
     return fp
@@ -315,20 +315,19 @@ def checked_fingerprint(path: str) -> dict:
 
 def checkpoint_domain(fingerprint: dict):
     """The domain (and layout) a checkpoint's run trained its last lesson on."""
-    from agents.curriculum import parse_plan
+    from agents.robostrich.runs import parse_plan
     return as_domain(parse_plan(fingerprint["plan"])[-1].domain, fingerprint.get("layout"))
 
 
 def load_run_from_checkpoint(path: str):
-    """Rebuild the CurriculumRun that wrote `path` (its fingerprint holds config, plan and seed)."""
-    from agents.curriculum import CurriculumRun, parse_plan
+    """Rebuild the DomainRun that wrote `path` (its fingerprint holds config, plan and seed)."""
+    from agents.robostrich.runs import DomainRun, parse_plan
     from agents.sac.config import SACConfig
     fp = checked_fingerprint(path)
     scratch = tempfile.mkdtemp(prefix="robostrich-evaluate-")  # the run's own files are left untouched
     try:
-        run = CurriculumRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch,
-                            task_kwargs=fp.get("task_kwargs"), layout=fp.get("layout"),
-                            init_from=fp.get("init_from"))
+        run = DomainRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch,
+                        task_kwargs=fp.get("task_kwargs"), layout=fp.get("layout"), init_from=fp.get("init_from"))
         run.restore(path)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
@@ -352,7 +351,7 @@ def main(argv=None):
     fingerprint = checked_fingerprint(args.checkpoint)  # every input checked before the run is rebuilt
     domain = checkpoint_domain(fingerprint)
     track_task = check_track_task(domain, args.track_task)
-    from agents.curriculum import parse_plan
+    from agents.robostrich.runs import parse_plan
     heldout_task = check_heldout_task(domain, args.heldout_task
                                       or default_heldout_task(domain, parse_plan(fingerprint["plan"])[-1].task))
     run = load_run_from_checkpoint(args.checkpoint)
@@ -367,7 +366,7 @@ def main(argv=None):
     if lookup is not None:
         reports["lookup"] = lookup
     if not args.no_figures and "track" in reports[args.label]:
-        from agents import figures
+        from agents.robostrich import figures
         figures.plot_track({label: r["track"] for label, r in reports.items()},
                            os.path.join(out, f"{args.label}_track.png"))
     summary = {label: {kind: r["summary"] for kind, r in rs.items()} for label, rs in reports.items()}

@@ -143,11 +143,11 @@ class Domain:
         return pool if num_targets is None else pool[spread_indices(len(pool), num_targets)]
 
     def lookup_table(self) -> Optional[dict]:
-        """The lookup baseline's stored poses for this layout (agents/lookup.py), positions in this
+        """The lookup baseline's stored poses for this layout (agents/robostrich/lookup.py), positions in this
         domain's frame; None off the arm."""
         if not self.is_arm:
             return None
-        from agents.lookup import lookup_table
+        from agents.robostrich.lookup import lookup_table
         from robostrich_suite import targets
         path = self._target_file()
         table = lookup_table(targets.level_head_poses(path), targets.heldout_targets(path))
@@ -157,7 +157,7 @@ class Domain:
     def moving_starts(self, count: int = 3):
         """Start poses of `heldout_moving`: `count` well separated training targets (picked as `track`
         picks its targets) and the stored inputs that hold them (never a held-out pose)."""
-        from agents.lookup import nearest
+        from agents.robostrich.lookup import nearest
         from robostrich_suite.tasks import reach
         from robostrich_suite import targets
         table = self.lookup_table()
@@ -173,7 +173,7 @@ class Domain:
             raise ValueError("stored starts (stored_starts, fixed_stored_starts) settle the arm holding stored "
                              "inputs on the frame; "
                              f"{self.name!r} stands on a quadruped, where it is not supported")
-        from agents.lookup import lookup_table
+        from agents.robostrich.lookup import lookup_table
         starts, _ = self.moving_starts()
         return lookup_table(self.lookup_table(), heldout=starts, exclusion=exclusion)["control"]
 

@@ -44,3 +44,11 @@ def tolerances(env):
 def is_success(position_error, attitude_error, position_tolerance=POSITION_TOLERANCE,
                attitude_tolerance=ATTITUDE_TOLERANCE) -> bool:
     return bool(position_error <= position_tolerance and attitude_error <= attitude_tolerance)
+
+
+def episode_metrics(env) -> dict:
+    """What an episode's record in metrics.jsonl gets from its last state: the head's errors and
+    whether they count as success (the curriculum loop's ``episode_probe``)."""
+    position_error, attitude_error = head_errors(env)
+    return {"position_error": position_error, "attitude_error": attitude_error,
+            "success": is_success(position_error, attitude_error, *tolerances(env))}

@@ -1,10 +1,10 @@
 """What the two application evaluations (Sec. 5.2) share: the policies compared, the gait of
 each seed and a rollout that records what each evaluation asks for.
 
-Why one place: `head_stabilize` (agents/stabilization.py) and `narrow_gap` (agents/gap.py)
+Why one place: `head_stabilize` (agents/robostrich/stabilization.py) and `narrow_gap` (agents/robostrich/gap.py)
 compare the same policies on `robostrich_a1` -- a trained checkpoint, optionally a second
 one (e.g. lessons 1-3 without lesson 4), zero tendon input and the no-learning lookup
-(agents/lookup.py) -- over the same seeds.
+(agents/robostrich/lookup.py) -- over the same seeds.
 
 Seeds are gait phases.  Both tasks are deterministic given the gait (one fixed target or
 sub-target list, a fixed start), so seed ``k`` of ``n`` starts the gait ``k / (2 n)`` of its
@@ -20,8 +20,8 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from agents import probes
-from agents.domains import Domain, as_domain
+from agents.robostrich import probes
+from agents.robostrich.domains import Domain, as_domain
 from robostrich_suite import cli as cli_lib
 
 DOMAIN = "robostrich_a1"
@@ -68,15 +68,15 @@ def zero_policy(domain: Domain) -> Policy:
 
 def lookup_policy(domain: Domain) -> Policy:
     """Hold the stored input of the level pose nearest to the target (trunk frame), re-chosen
-    every step as the target moves (agents/lookup.py)."""
-    from agents.lookup import LABEL, LookupPolicy
+    every step as the target moves (agents/robostrich/lookup.py)."""
+    from agents.robostrich.lookup import LABEL, LookupPolicy
     table = domain.lookup_table()
     return Policy(LABEL, domain, lambda env, flattener: LookupPolicy(flattener, table))
 
 
 def checkpoint_policy(path: str, label: str) -> Policy:
     """The deterministic actor of a `robostrich-train` checkpoint trained on `robostrich_a1`."""
-    from agents.evaluation import load_run_from_checkpoint
+    from agents.robostrich.evaluation import load_run_from_checkpoint
     from agents.sac.builder import SACBuilder
     run = load_run_from_checkpoint(path)
     domain = run.domain()
@@ -171,10 +171,10 @@ def rollouts(policy: Policy, task: str, seeds: int, gait, record_for: Callable,
 
 
 def open_recorder(path: Optional[str], name: str):
-    """A Rerun recorder writing `path` (agents/recording.py), or None for no recording."""
+    """A Rerun recorder writing `path` (agents/robostrich/recording.py), or None for no recording."""
     if path is None:
         return None
-    from agents.recording import RolloutRecorder
+    from agents.robostrich.recording import RolloutRecorder
     return RolloutRecorder(path, name=name)
 
 

@@ -1,0 +1,103 @@
+"""A curriculum run over named domains: the arm's tasks (with a tendon layout and task options)
+or dm_control's, with the lookup as the residual policy's base and the head's errors in every
+episode's record."""
+from typing import Callable, Optional, Sequence
+
+from agents import curriculum
+from agents.curriculum import Lesson
+from agents.robostrich import probes
+from agents.robostrich.domains import as_domain
+from agents.sac.config import SACConfig
+
+DEFAULT_DOMAIN = "robostrich"
+
+
+def parse_plan(text: str, default_domain: str = DEFAULT_DOMAIN):
+    """'lesson1:50000,lesson2:50000' or 'point_mass/easy:2000' -> [Lesson, ...] (the arm by default)."""
+    return curriculum.parse_plan(text, default_domain)
+
+
+def make_environment(domain, task: str, seed: int, **task_kwargs):
+    """robostrich_suite.load for the arm domains, dm_control.suite.load otherwise (agents/robostrich/domains.py);
+    `domain` is a name or a Domain (which may carry a tendon layout)."""
+    return as_domain(domain).make_environment(task, seed, **task_kwargs)
+
+
+def _is_arm_plan(plan) -> bool:
+    return bool(plan) and all(as_domain(lesson.domain).is_arm for lesson in plan)
+
+
+def named_layout(layout: Optional[str], plan) -> Optional[str]:
+    """The tendon layout a run on ``plan`` trains, by name: ``layout``, or the tasks' default on
+    the arm domains (None off them)."""
+    if layout is not None or not _is_arm_plan(plan):
+        return layout
+    return as_domain(plan[-1].domain).layout  # the arm domain names its default
+
+
+def identity_extra(plan, task_kwargs: Optional[dict] = None, layout: Optional[str] = None,
+                   init_from: Optional[str] = None) -> dict:
+    """What a run's fingerprint holds beside config, plan and seed: the task options, the layout
+    by name and ``init_from``, the content hash of the checkpoint the run started from (agents/robostrich/transfer.py)."""
+    extra = {}
+    if task_kwargs:
+        extra["task_kwargs"] = dict(task_kwargs)
+    layout = named_layout(layout, plan)
+    if layout is not None:
+        extra["layout"] = layout
+    if init_from is not None:
+        extra["init_from"] = init_from
+    return extra
+
+
+def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, task_kwargs: Optional[dict] = None,
+                 layout: Optional[str] = None, init_from: Optional[str] = None) -> dict:
+    """The fingerprint part known before a run is built (robostrich-train checks a resume against it)."""
+    return curriculum.run_identity(plan, config, seed, identity_extra(plan, task_kwargs, layout, init_from))
+
+
+def check_lesson_names(plan, config: SACConfig, layout: Optional[str] = None) -> None:
+    """ValueError naming the field if a per-lesson setting names a task the plan's domains lack (dm_control's
+    tasks have no goal reward, so HER's lessons are checked on the arm only). An unknown `layout`, or
+    one on a dm_control plan, fails here too."""
+    arm_domains = {d for d in (as_domain(lesson.domain, layout) for lesson in plan) if d.is_arm}
+    curriculum.check_lesson_names(plan, config, [t for d in arm_domains for t in d.tasks()], bool(arm_domains))
+
+
+class DomainRun(curriculum.CurriculumRun):
+    """A CurriculumRun whose lessons name domains of agents/robostrich/domains.py."""
+
+    def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
+                 checkpoint_every: int = 10_000, env_factory: Callable = make_environment, name: str = "run",
+                 task_kwargs: Optional[dict] = None, layout: Optional[str] = None,
+                 init_from: Optional[str] = None, keep_lesson_checkpoints: bool = False):
+        """``task_kwargs`` go to every lesson's task (e.g. eq. 10's ``weights``); ``layout`` names a
+        built-in tendon layout of the arm domains (its own targets come with it); ``init_from`` is the
+        content hash of the checkpoint whose learner this run starts from (transfer.initialize puts
+        it there); ``env_factory(domain, task, seed, **task_kwargs)`` builds a lesson's environment."""
+        check_lesson_names(plan, config, layout)  # and an unknown layout fails here, not mid-run
+        self.task_kwargs = dict(task_kwargs or {})
+        self.layout = layout
+        self.init_from = init_from
+        self.env_factory = env_factory
+        super().__init__(plan, config, seed, run_dir, self._make_lesson_environment, checkpoint_every, name,
+                         base_policy=self._base_policy(plan, config), episode_probe=probes.episode_metrics, keep_lesson_checkpoints=keep_lesson_checkpoints)
+
+    def extra_identity(self) -> dict:
+        """The task options, the layout and ``init_from`` (which transfer.initialize may set after building)."""
+        return identity_extra(self.plan, self.task_kwargs, self.layout, self.init_from)
+
+    def _make_lesson_environment(self, lesson: Lesson, seed: int):
+        return self.env_factory(self.domain(lesson), lesson.task, seed, **self.task_kwargs)
+
+    def _base_policy(self, plan, config: SACConfig):
+        """The residual's base: the lookup of the first lesson's domain and layout."""
+        if config.residual_scale <= 0:
+            return None
+        from agents.robostrich.lookup import LookupPolicy
+        table = self.domain(plan[0]).lookup_table()
+        return lambda flattener: LookupPolicy(flattener, table)
+
+    def domain(self, lesson: Optional[Lesson] = None):
+        """The Domain of `lesson` (default: the last), with this run's layout."""
+        return as_domain((lesson or self.plan[-1]).domain, self.layout)
