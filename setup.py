@@ -38,7 +38,7 @@ setup(
             "robostrich-export-xml = robostrich_suite.xml_export:cli",
             "robostrich-movement = robostrich_suite.studies.movement:cli",
             "robostrich-workspace = robostrich_suite.studies.workspace:cli",
-            "robostrich-layouts = robostrich_suite.studies.layout_compare:cli",
+            "robostrich-layouts = agents.robostrich.layouts:cli",
             "robostrich-targets = robostrich_suite.studies.target_generation:cli",
             "robostrich-gait = robostrich_suite.studies.gait_generation:cli",
             "robostrich-stabilize = agents.robostrich.application_commands:stabilize_cli",

@@ -20,8 +20,8 @@ from dm_control.mujoco import engine
 from dm_control.rl import control
 
 from robostrich_suite.model import arm as arm_lib
+from robostrich_suite.model import legs
 from robostrich_suite.model import quadruped as quad
-from robostrich_suite.tasks import gait as gait_lib
 
 _log = logging.getLogger(__name__)
 # dm_control's message for an invalid state, so both step paths report it alike.
@@ -526,8 +526,8 @@ class QuadrupedPhysicsMixin(ArmPhysicsMixin):
 
     def place_standing(self, trunk_xy=(0.0, 0.0), trunk_height=quad.STANDING_TRUNK_HEIGHT):
         """Put the quadruped in its standing pose, feet on the ground, arm straight, at rest."""
-        targets = gait_lib.Standing().joint_targets(0.0, trunk_height + gait_lib.SAG_COMPENSATION["stand"])
-        _, foot_z = gait_lib.leg_fk(targets[1], targets[2])
+        targets = legs.standing_joint_targets(trunk_height + legs.SAG_COMPENSATION["stand"])
+        _, foot_z = legs.leg_fk(targets[1], targets[2])
         self._raw_data.qpos[:] = 0.0
         self._raw_data.qpos[:3] = [trunk_xy[0], trunk_xy[1], -foot_z + quad.FOOT_RADIUS]
         self._raw_data.qpos[3:7] = [1, 0, 0, 0]

@@ -22,7 +22,7 @@ import zipfile
 
 import numpy as np
 
-from robostrich_suite.model import fingerprint as fingerprint_lib
+from robostrich_suite import fingerprint as fingerprint_lib
 
 FORMAT_VERSION = 1
 POLICY_DIR = pathlib.Path(__file__).parent / "data" / "policies"

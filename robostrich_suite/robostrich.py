@@ -19,8 +19,8 @@ import collections.abc  # noqa: F401  dm_control.utils.containers uses it withou
 
 from dm_control.utils import containers
 
-from robostrich_suite import targets as targets_lib
-from robostrich_suite.model import scenes
+from robostrich_suite import fingerprint as fingerprint_lib
+from robostrich_suite import scenes
 from robostrich_suite.tasks import lessons, reach
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
 
@@ -51,7 +51,7 @@ def track(time_limit=None, random=None, environment_kwargs=None, arm_spec=None,
           **task_kwargs):
     """Reach three targets in order (Fig. 7); per-step errors are in the observation."""
     if targets is None:
-        targets_lib.warn_if_other_arm(arm_spec, tendon_layout)
+        fingerprint_lib.warn_if_other_arm(arm_spec, tendon_layout)
     task = reach.Track(targets=targets, steps_per_target=steps_per_target, random=random,
                        **task_kwargs)
     if time_limit is None:

@@ -17,7 +17,7 @@ Tasks:
   The planar neck fits the slot; the head must go under the shelf and up through the
   slot.  The arm collides with all of it (its geoms carry the arm's contact bit).
 
-The model is :func:`robostrich_suite.model.scenes.build_a1`; the tasks, the trunk frame
+The model is :func:`robostrich_suite.scenes.build_a1`; the tasks, the trunk frame
 their targets and observations are given in, and the gait are in
 :mod:`robostrich_suite.tasks.quadruped_tasks`.  Run ``robostrich-walk`` to see the
 perturbation the arm gets.
@@ -30,7 +30,7 @@ from dm_control import mujoco
 from dm_control.utils import containers
 
 from robostrich_suite import physics as physics_lib
-from robostrich_suite.model import scenes
+from robostrich_suite import scenes
 from robostrich_suite.tasks import lessons
 from robostrich_suite.tasks import quadruped_tasks as tasks
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP

@@ -88,25 +88,6 @@ def heldout_targets(path: str | pathlib.Path = DATA_PATH) -> np.ndarray:
     return _split(True, str(path))
 
 
-def warn_if_other_arm(spec=None, layout=None) -> bool:
-    """Warn (and return True) when the shipped targets were made with another arm than
-    ``spec``/``layout``: its level-head poses differ, so some targets may be out of reach
-    or not holdable with a level head."""
-    from robostrich_suite.model import fingerprint as fingerprint_lib
-    if spec is None and layout is None:
-        return False
-    shipped = str(level_head_poses()["fingerprint"])
-    if fingerprint_lib.model_fingerprint(spec, layout) == shipped:
-        return False
-    import warnings
-    warnings.warn(
-        "the shipped targets were made with the default arm, not this arm spec/tendon layout; "
-        "some may be unreachable. Make targets for it with robostrich_suite.studies.target_generation.generate("
-        "..., spec=..., layout=..., path=FILE) and pass target_pool=training_targets(FILE).",
-        stacklevel=3)
-    return True
-
-
 def clear_cache() -> None:
     """Forget the files read so far: a rewritten target file is read anew."""
     _load.cache_clear()

@@ -8,7 +8,8 @@ from dm_control import mjcf
 
 from robostrich_suite import physics as physics_lib
 from robostrich_suite import xml_export
-from robostrich_suite.model import arm, scenes, table1
+from robostrich_suite import scenes
+from robostrich_suite.model import arm, table1
 from robostrich_suite.robostrich import Physics, get_model_and_assets
 
 

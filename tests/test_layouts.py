@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from robostrich_suite.model import arm, layouts
-from robostrich_suite.model import fingerprint as fingerprint_lib
+from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite.studies import coverage, layout_compare, workspace
 
 from conftest import console_script

@@ -7,7 +7,8 @@ from dm_env import test_utils
 
 import robostrich_suite
 from robostrich_suite import robostrich_a1 as a1, xml_export
-from robostrich_suite.model import arm, quadruped as quad, scenes
+from robostrich_suite import scenes
+from robostrich_suite.model import arm, quadruped as quad
 from robostrich_suite.studies import walk
 from robostrich_suite.tasks import gait, quadruped_tasks
 

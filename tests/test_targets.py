@@ -9,8 +9,8 @@ from robostrich_suite import physics as physics_lib
 from robostrich_suite import targets
 from robostrich_suite.model import arm
 from robostrich_suite.model import layouts as layouts_lib
-from robostrich_suite.model import fingerprint as fingerprint_lib
-from robostrich_suite.model import scenes
+from robostrich_suite import fingerprint as fingerprint_lib
+from robostrich_suite import scenes
 from robostrich_suite.studies import pose_seek, target_generation, workspace
 
 

@@ -4,8 +4,8 @@ import pytest
 
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm
-from robostrich_suite.model import fingerprint as fingerprint_lib
-from robostrich_suite.model import scenes
+from robostrich_suite import fingerprint as fingerprint_lib
+from robostrich_suite import scenes
 from robostrich_suite.studies import target_generation, workspace
 
 

@@ -188,7 +188,7 @@ def evaluate(policies: list, seeds: int, gait, record_dir: Optional[str] = None,
 
 def scene() -> dict:
     """The obstacle's outline in the x-z plane (for the figure): wall, shelf pieces, slot."""
-    from robostrich_suite.model import scenes as s
+    from robostrich_suite import scenes as s
     x0, shelf_top = s.GAP_WALL_X, s.GAP_SHELF_BOTTOM + s.GAP_SHELF_THICKNESS
     return {
         "wall": [x0 - s.WALL_THICKNESS, shelf_top, x0, s.GAP_WALL_TOP],  # x0, z0, x1, z1

@@ -10,7 +10,7 @@ from agents import checkpoint
 from agents.actors import ResidualAdapter
 from agents.robostrich.runs import make_environment
 from robostrich_suite import policies
-from robostrich_suite.model import fingerprint as fingerprint_lib
+from robostrich_suite import fingerprint as fingerprint_lib
 
 
 def _layers(params: dict):

@@ -33,7 +33,7 @@ import numpy as np
 from dm_control import mjcf
 
 from robostrich_suite.model import table1
-from robostrich_suite.tasks.conventions import PHYSICS_TIMESTEP
+from robostrich_suite.model.timesteps import PHYSICS_TIMESTEP
 
 SIDES = ("dorsal", "ventral")
 ARM_MODEL_NAME = "arm"
@@ -312,6 +312,21 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
     model.compiler.angle = "radian"
     model.option.integrator = "implicitfast"
     model.option.timestep = PHYSICS_TIMESTEP
+    _add_defaults(model, spec)
+    base = model.worldbody.add("body", name="base")
+    base.add("geom", name="base_plate", type="box", size=[0.03, 0.02, 0.005],
+             pos=[0, 0, -spec.anchor_depth - 0.005], contype=COLLISION_TYPE, conaffinity=0,
+             rgba=[0.3, 0.3, 0.3, 1], mass=0.05)
+    side_x = {"dorsal": -spec.hole_offset, "ventral": spec.hole_offset}
+    _add_chain(model, base, spec, side_x)
+    _add_tendons(model, base, spec, layout, side_x)
+    _exclude_touching_links(model, spec)
+    _add_tendon_servos(model, spec, layout)
+    return model
+
+
+def _add_defaults(model: mjcf.RootElement, spec: ArmSpec) -> None:
+    """The ``link`` class (capsules, limited hinges with the passive spring) and the ``tendon`` class."""
     link_default = model.default.add("default", dclass="link")
     link_default.geom.set_attributes(type="capsule", size=[spec.link_radius],
                                      contype=COLLISION_TYPE | SELF_COLLISION_TYPE,
@@ -329,13 +344,9 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
         gaintype="fixed", biastype="affine", ctrllimited=True, forcelimited=True,
         forcerange=[-spec.tendon_max_force, 0.0])
 
-    base = model.worldbody.add("body", name="base")
-    base.add("geom", name="base_plate", type="box", size=[0.03, 0.02, 0.005],
-             pos=[0, 0, -spec.anchor_depth - 0.005], contype=COLLISION_TYPE, conaffinity=0,
-             rgba=[0.3, 0.3, 0.3, 1], mass=0.05)
-    side_x = {"dorsal": -spec.hole_offset, "ventral": spec.hole_offset}
 
-    # Build the chain caudal -> cranial: the base link's joint sits at the base origin.
+def _add_chain(model: mjcf.RootElement, base, spec: ArmSpec, side_x: dict) -> None:
+    """The links, caudal -> cranial (the base link's joint at the base origin), with their holes and the head site."""
     joint_range = dict(zip(spec.joint_names, spec.joint_range_rad()))
     masses = dict(zip(spec.joint_names, spec.masses))
     lengths = dict(zip(spec.joint_names[1:], spec.link_lengths))
@@ -359,6 +370,9 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
                      pos=[side_x[side], 0, spec.hole_fraction * length])
         parent, pos = body, length
 
+
+def _add_tendons(model: mjcf.RootElement, base, spec: ArmSpec, layout: TendonLayout, side_x: dict) -> None:
+    """Each tendon from its anchor on the base (if it starts there) through its links' holes."""
     for tendon in layout.tendons:
         element = model.tendon.add("spatial", name=tendon.name, dclass="tendon",
                                    rgba=[0.1, 0.5, 0.9, 1] if tendon.side == "ventral"
@@ -370,10 +384,6 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
             element.add("site", site=anchor)
         for link in tendon.links:
             element.add("site", site=hole_site_name(link, tendon.side))
-
-    _exclude_touching_links(model, spec)
-    _add_tendon_servos(model, spec, layout)
-    return model
 
 
 def _link_geom_radius(spec: ArmSpec, name: str) -> float:

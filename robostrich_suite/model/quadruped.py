@@ -3,7 +3,7 @@
 Every number about the robot is a named constant in this module.  The model
 is built *without* a free joint so that the arm can be attached to its trunk
 first: ``dm_control.mjcf`` refuses to attach a child whose top body has a free
-joint.  The composition (:func:`robostrich_suite.model.scenes.build_a1`)
+joint.  The composition (:func:`robostrich_suite.scenes.build_a1`)
 attaches the arm to ``MOUNT_SITE``, then adds the free joint to the trunk and
 the arena (floor, light, obstacles) into this root model.
 

@@ -15,9 +15,10 @@ Every case is one routing on the same Table 1 links.  Per case:
 * **rolling / lever**: the movement tests' attitude ranges at equal head travel and
   their ratio (:mod:`robostrich_suite.studies.movement`; the layout's ventral tendons ramped
   caudal to cranial, its most cranial dorsal tendon's input held);
-* **lookup**: held-out success of the no-learning baseline (nearest stored level
-  pose, hold its inputs) on the case's own targets; with ``--train``, the held-out
-  success of a short curriculum run of ``robostrich-train``'s learner too.
+* **lookup** (the installed command, from the agent's side: ``agents/robostrich/layouts.py``):
+  held-out success of the no-learning baseline (nearest stored level pose, hold its inputs) on
+  the case's own targets; with ``--train``, the held-out success of a short curriculum run of
+  ``robostrich-train``'s learner too.
 
 Writes ``layouts.md``, ``layouts.csv``, ``layouts.png`` (blue region with the held
 level poses, and the routing on a stick figure, per case) and ``targets/CASE.npz``.
@@ -29,12 +30,11 @@ import dataclasses
 import pathlib
 import time
 
-import numpy as np
 
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import targets
 from robostrich_suite.model import arm as arm_lib
-from robostrich_suite.model import fingerprint as fingerprint_lib
+from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite.model import layouts as layouts_lib
 from robostrich_suite.studies import coverage as coverage_lib
 from robostrich_suite.studies import movement, pose_seek, target_generation, workspace
@@ -42,7 +42,6 @@ from robostrich_suite.studies import movement, pose_seek, target_generation, wor
 PROG = "robostrich-layouts"
 DEFAULT_KINEMATIC_SAMPLES = 100_000  # the issue's blue region: workspace.kinematic_samples(100000)
 DEFAULT_RANDOM_SAMPLES = 300
-DEFAULT_TRAIN_STEPS = 4000
 RANDOM_CHUNK = 10  # random samples per progress update
 
 
@@ -62,14 +61,14 @@ class Options:
     seek_time: float = pose_seek.SEEK_TIME
     seed: int = 0
     movement: bool = True
-    lookup: bool = True
-    train_steps: int = 0  # 0: no curriculum run
     out: pathlib.Path = pathlib.Path("out/layouts")
+    # Further measures of a case, in order: ``measure(case, target_path, options) -> dict`` of
+    # columns (the held-out success of policies on the case's targets, from the agent's side).
+    measures: tuple = ()
 
     def units(self, region: coverage_lib.BlueRegion) -> int:
         """Progress units of one case: one per sampled pose, one per later stage."""
-        return (self.random_samples + len(region.head_position) + self.movement + self.lookup
-                + (self.train_steps > 0))
+        return self.random_samples + len(region.head_position) + self.movement + len(self.measures)
 
 
 # --------------------------------------------------------------------------- measures
@@ -113,55 +112,6 @@ def movement_ratio(case: Case) -> dict:
             "rolling_lever_ratio": ratio, "head_travel_mm": 1000 * rolling.head_travel()}
 
 
-def heldout_success(case: Case, heldout: np.ndarray, make_actor, seed: int = 10_000) -> dict:
-    """``agents.robostrich.evaluation``'s held-out summary on the case's arm: one lesson-2 episode
-    from the fixed start per target.  ``make_actor(flattener)`` gives the policy."""
-    import robostrich_suite
-    from agents.robostrich import evaluation
-    from agents.replay import ObservationFlattener
-    env = robostrich_suite.load("robostrich", evaluation.default_heldout_task("robostrich", "lesson3"),
-                                task_kwargs=dict(random=seed, arm_spec=case.spec,
-                                                 tendon_layout=case.layout, target_pool=heldout[:1]))
-    flattener = ObservationFlattener(env.observation_spec())
-    actor = make_actor(flattener)
-    episodes = []
-    for target in heldout:
-        env.task.target_pool = np.asarray(target, np.float64)[None]
-        episodes.append(evaluation._episode_summary(evaluation.rollout(env, actor, flattener)))
-    return evaluation.summarize(episodes)
-
-
-def lookup_success(case: Case, target_path: pathlib.Path) -> dict:
-    """The lookup baseline on the case's own targets (its table keeps no held-out pose)."""
-    from agents.robostrich.lookup import LookupPolicy, lookup_table
-    heldout = targets.heldout_targets(target_path)
-    table = lookup_table(targets.level_head_poses(target_path), heldout)
-    return heldout_success(case, heldout, lambda flattener: LookupPolicy(flattener, table))
-
-
-def curriculum_success(case: Case, target_path: pathlib.Path, steps: int, seed: int,
-                       run_dir: pathlib.Path) -> dict:
-    """A short curriculum (lessons 1-3 in equal parts, ``robostrich-train``'s learner and
-    defaults) on the case's own training targets, then its held-out success."""
-    from agents.robostrich.runs import DomainRun, make_environment, parse_plan
-    from agents.sac.builder import SACBuilder
-    from agents.sac.config import SACConfig
-    from agents.robostrich.training import FIXED_START_ARM_TASK_KWARGS
-    arm_kwargs = dict(arm_spec=case.spec, tendon_layout=case.layout,
-                      target_pool=targets.training_targets(target_path))
-
-    def env_factory(domain, task, env_seed, **task_kwargs):  # the arm stays out of the fingerprint
-        return make_environment(domain, task, env_seed, **arm_kwargs, **task_kwargs)
-
-    per_lesson = max(steps // 3, 1)
-    plan = parse_plan(",".join(f"lesson{i}:{per_lesson}" for i in (1, 2, 3)))
-    run = DomainRun(plan, SACConfig(), seed, str(run_dir), checkpoint_every=10 ** 9,
-                        env_factory=env_factory, name=case.label, task_kwargs=FIXED_START_ARM_TASK_KWARGS)
-    run.run()
-    actor = SACBuilder.make_eval_actor(run.loop)
-    return heldout_success(case, targets.heldout_targets(target_path), lambda flattener: actor)
-
-
 def measure(case: Case, region: coverage_lib.BlueRegion, options: Options, progress=None) -> dict:
     """Every measure of one case; ``progress(n)`` advances a bar by n units."""
     progress = progress or (lambda n: None)
@@ -193,17 +143,9 @@ def measure(case: Case, region: coverage_lib.BlueRegion, options: Options, progr
     if options.movement:
         row.update(movement_ratio(case))
         progress(1)
-    heldout_count = len(targets.heldout_targets(target_path)) if len(held) else 0
-    row["heldout_targets"] = heldout_count
-    if options.lookup:
-        row["lookup_success"] = (lookup_success(case, target_path)["success_rate"]
-                                 if heldout_count else None)
-        progress(1)
-    if options.train_steps > 0:
-        row["curriculum_success"] = (
-            curriculum_success(case, target_path, options.train_steps, options.seed,
-                               options.out / "train" / case.label)["success_rate"]
-            if heldout_count and len(targets.training_targets(target_path)) else None)
+    row["heldout_targets"] = len(targets.heldout_targets(target_path)) if len(held) else 0
+    for extra in options.measures:
+        row.update(extra(case, target_path, options))
         progress(1)
     return {"row": row, "held": held, "covered": covered}
 
@@ -314,15 +256,15 @@ def write_csv(path: pathlib.Path, rows) -> None:
 
 # --------------------------------------------------------------------------- command line
 
-def main(argv=None) -> dict:
-    """Command line: measure the cases, write the table, the CSV, the figure and the targets."""
+def build_parser() -> cli_lib.Parser:
+    """The command's options; the agent's side (agents/robostrich/layouts.py) adds its own."""
     parser = cli_lib.Parser(
         prog=PROG,
         description="Compare tendon layouts (and passive joint stiffnesses) of the Robostrich "
                     "arm on the same Table 1 links: share of the blue region of Fig. 6 held "
                     "level (coverage), distinct level targets, rolling/lever attitude ranges, "
-                    "held-out success of the lookup baseline (and, with --train, of a short "
-                    "curriculum run). Writes layouts.md, layouts.csv, layouts.png and "
+                    "and, from the agent's side, held-out success of the lookup baseline (and, "
+                    "with --train, of a short curriculum run). Writes layouts.md, layouts.csv, layouts.png and "
                     "targets/LAYOUT.npz under --out.",
         epilog="built-in layouts: " + "; ".join(f"{name}: {b.description}"
                                                  for name, b in layouts_lib.BUILT_IN.items()))
@@ -353,31 +295,39 @@ def main(argv=None) -> dict:
                              "(default: %(default)s)")
     parser.add_argument("--seed", type=cli_lib.seed, default=0, help="random seed (default: %(default)s)")
     parser.add_argument("--no-movement", action="store_true", help="skip the rolling/lever tests")
-    parser.add_argument("--no-lookup", action="store_true", help="skip the lookup baseline")
-    parser.add_argument("--train", action="store_true",
-                        help="also train a short curriculum per case on its own targets and "
-                             "report its held-out success")
-    parser.add_argument("--train-steps", type=cli_lib.whole_number(1), default=DEFAULT_TRAIN_STEPS,
-                        help="control steps of that run, split over lessons 1-3 (default: %(default)s)")
     parser.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS), default=1,
                         help="processes, one case each (default: %(default)s)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return parser
+
+
+def main(argv=None, parser=None, measures_from_args=lambda args: ()) -> dict:
+    """Command line: measure the cases, write the table, the CSV, the figure and the targets.
+    ``parser`` (default :func:`build_parser`) may carry more options, from which
+    ``measures_from_args(args)`` makes the further measures of every case (``Options.measures``)."""
+    parser = parser or build_parser()
     args = parser.parse_args(argv)
     if args.candidates:
         args.layouts = layouts_lib.fig1b_candidates()
     if not args.layouts and not args.layout_file:
         parser.error("nothing to compare: give --layouts and/or --layout-file")
-
     start = time.perf_counter()
     cases = make_cases(args.layouts, args.layout_file, args.stiffness)
-    options = Options(args.random_samples, args.seek_time, args.seed, not args.no_movement,
-                      not args.no_lookup, args.train_steps if args.train else 0, args.out)
+    options = Options(args.random_samples, args.seek_time, args.seed, not args.no_movement, args.out,
+                      tuple(measures_from_args(args)))
     region = coverage_lib.BlueRegion.from_samples(
         workspace.kinematic_samples(args.kinematic_samples, args.seed, cases[0].spec))
     if region.num_cells == 0:
         raise ValueError(f"no level head among {args.kinematic_samples} kinematic samples; "
                          "raise --kinematic-samples")
     results = measure_all(cases, region, options, args.workers, not args.no_progress)
+    figure = report(args, cases, region, results)
+    print(f"done in {time.perf_counter() - start:.1f} s")
+    return {"rows": [r["row"] for r in results], "figure": figure}
+
+
+def report(args, cases, region, results) -> pathlib.Path:
+    """Write layouts.md, layouts.csv and layouts.png under ``args.out`` and print the table."""
     rows = [r["row"] for r in results]
     args.out.mkdir(parents=True, exist_ok=True)
     table = markdown_table(rows)
@@ -396,12 +346,12 @@ def main(argv=None) -> dict:
         print(f"wrote {args.out / name}")
     print(f"wrote {figure}")
     print(f"wrote {args.out / 'targets'}/ (one target file per layout)")
-    print(f"done in {time.perf_counter() - start:.1f} s")
-    return {"rows": rows, "figure": figure}
+    return figure
 
 
 def cli(argv=None) -> int:
-    """Console script `robostrich-layouts`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
+    """The comparison without the agent's measures: exit status 0, or 2 with a one-line error
+    (robostrich_suite.cli); the installed ``robostrich-layouts`` is agents/robostrich/layouts.py's."""
     return cli_lib.run(main, PROG, argv)
 
 

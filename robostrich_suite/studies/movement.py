@@ -22,7 +22,7 @@ from dm_control.rl import control as control_lib
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
-from robostrich_suite.model import scenes
+from robostrich_suite import scenes
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
 
 PATTERNS = ("rolling", "lever")
@@ -358,9 +358,7 @@ def pose_family(num_poses: int, dorsal: float = MovementConfig.dorsal, seed: int
 MAX_RAMP_TIME = 60.0  # s per tendon: the whole test is about 8 of them
 
 
-def main(argv=None) -> dict:
-    """Command line: run both patterns, write a PNG and a Rerun recording of each."""
-    from robostrich_suite.studies import movement_figure
+def build_parser() -> cli_lib.Parser:
     parser = cli_lib.Parser(
         prog="robostrich-movement",
         description="The paper's movement tests (Sec. 4.3, Figs. 4-5): rolling and lever "
@@ -405,8 +403,12 @@ def main(argv=None) -> dict:
                              "(about 0.1 s each; default: %(default)s)")
     parser.add_argument("--no-recording", action="store_true", help="skip the .rrd files")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
-    args = parser.parse_args(argv)
+    return parser
 
+
+def main(argv=None) -> dict:
+    """Command line: run both patterns, write a PNG and a Rerun recording of each."""
+    args = build_parser().parse_args(argv)
     overrides = {} if args.joint_stiffness is None else {"joint_stiffness": args.joint_stiffness}
     spec = arm_lib.ArmSpec.from_table1(**overrides)
     setting = dict(ventral_span=args.ventral_span, dorsal=args.dorsal, amplitude=args.amplitude,
@@ -418,10 +420,28 @@ def main(argv=None) -> dict:
     ventral = sum(t.side == "ventral" for t in base.layout(spec).tendons)
     for pattern in args.patterns:  # every bad setting before anything is written
         dataclasses.replace(base, pattern=pattern).validate(ventral)
+    start = time.perf_counter()
+    results, written = run_patterns(args, base, spec)
+    if args.pose_family > 0:
+        family = pose_family(args.pose_family, base.dorsal, args.seed, spec, progress=not args.no_progress,
+                             layout=base.layout(spec))
+        near, far = family.attitude_spread()
+        print(f"static poses at dorsal {base.dorsal} m: {family.settled.sum()} of "
+              f"{args.pose_family} settled; attitude differs by a median {near:.1f} deg between "
+              f"heads within 15 mm, {far:.1f} deg between heads over 100 mm apart")
+    for path in written:
+        print(f"wrote {path}")
+    print(f"done in {time.perf_counter() - start:.1f} s")
+    return results
+
+
+def run_patterns(args, base: MovementConfig, spec) -> tuple[dict, list]:
+    """Each pattern of ``args.patterns`` (rolling first: the lever matches its head travel), with
+    its figure and recording; prints a line per pattern and the ratio. Returns (results, files)."""
+    from robostrich_suite.studies import movement_figure
     progress = not args.no_progress
     written, results = [], {}
-    start = time.perf_counter()
-    for pattern in sorted(args.patterns, key=PATTERNS.index):  # rolling first: the lever matches it
+    for pattern in sorted(args.patterns, key=PATTERNS.index):
         config = dataclasses.replace(base, pattern=pattern)
         if pattern == "lever" and "rolling" in results and not args.no_match_travel:
             amplitude = match_lever_amplitude(config, results["rolling"].head_travel(), spec,
@@ -447,17 +467,7 @@ def main(argv=None) -> dict:
     if len(results) == 2:
         ratio = results["rolling"].attitude_range() / max(results["lever"].attitude_range(), 1e-9)
         print(f"attitude range rolling / lever: {ratio:.2f}")
-    if args.pose_family > 0:
-        family = pose_family(args.pose_family, base.dorsal, args.seed, spec, progress=progress,
-                             layout=base.layout(spec))
-        near, far = family.attitude_spread()
-        print(f"static poses at dorsal {base.dorsal} m: {family.settled.sum()} of "
-              f"{args.pose_family} settled; attitude differs by a median {near:.1f} deg between "
-              f"heads within 15 mm, {far:.1f} deg between heads over 100 mm apart")
-    for path in written:
-        print(f"wrote {path}")
-    print(f"done in {time.perf_counter() - start:.1f} s")
-    return results
+    return results, written
 
 
 def cli(argv=None) -> int:

@@ -21,7 +21,7 @@ import numpy as np
 
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
-from robostrich_suite.model import scenes
+from robostrich_suite import scenes
 from robostrich_suite.studies import workspace
 from robostrich_suite.tasks import conventions
 

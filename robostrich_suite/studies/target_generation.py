@@ -22,7 +22,7 @@ import numpy as np
 
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import targets
-from robostrich_suite.model import fingerprint as fingerprint_lib
+from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite.studies import pose_seek, workspace
 
 SEEK_LEVEL_TIME = 2.5  # s of dorsal-input tuning per draw before it is held
@@ -97,7 +97,7 @@ def recheck(path: pathlib.Path, spec=None, layout=None, settle_time: float = pos
     ``layout``) and rewrite the file with the poses that still come to rest level, at
     the positions they reach now; returns ``(kept, stored)``.  Where fewer than half are
     kept the file is most likely another arm's: ValueError, and the file stays."""
-    from robostrich_suite.model import scenes
+    from robostrich_suite import scenes
     poses = targets.level_head_poses(path)
     physics = scenes.frame_physics(spec, layout)
     if poses["control"].shape[1] != physics.model.nu:

@@ -25,8 +25,8 @@ import numpy as np
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
-from robostrich_suite.model import fingerprint as fingerprint_lib
-from robostrich_suite.model import scenes
+from robostrich_suite import fingerprint as fingerprint_lib
+from robostrich_suite import scenes
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
 from robostrich_suite.tasks.lessons import LESSON_TIME_LIMIT
 

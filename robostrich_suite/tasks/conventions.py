@@ -3,6 +3,7 @@
 The level head (the tasks' desired attitude and the workspace's blue region),
 the tasks' success tolerances (and the precise reach evaluations report) and the timesteps (paper Sec. 4.2).
 """
+from robostrich_suite.model.timesteps import CONTROL_TIMESTEP, PHYSICS_TIMESTEP  # noqa: F401 (the model's)
 
 LEVEL_ATTITUDE_DEG = 90.0  # deg: head parallel to the ground (paper Fig. 2B)
 LEVEL_TOLERANCE_DEG = 5.0  # deg: a head within this of level counts as level
@@ -13,5 +14,3 @@ POSITION_TOLERANCE = 0.05  # m (paper Sec. 4.2)
 PRECISE_POSITION_TOLERANCE = 0.01  # m
 PRECISE_ATTITUDE_TOLERANCE_DEG = 2.0  # deg
 
-CONTROL_TIMESTEP = 0.008  # s (paper Sec. 4.2)
-PHYSICS_TIMESTEP = 0.002  # s; 4 substeps per control step

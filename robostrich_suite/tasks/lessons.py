@@ -17,7 +17,7 @@ from typing import Callable
 
 from dm_control.rl import control
 
-from robostrich_suite import targets
+from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite.tasks import reach
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
 
@@ -57,7 +57,7 @@ class LessonFactory:
         """A ``reach_task`` environment; warns when the default targets were made with
         another arm than ``arm_spec``/``tendon_layout``."""
         if "target_pool" not in task_kwargs:
-            targets.warn_if_other_arm(arm_spec, tendon_layout)
+            fingerprint_lib.warn_if_other_arm(arm_spec, tendon_layout)
         task = self.reach_task(reward=reward, initial_state=initial_state, random=random,
                                **task_options, **task_kwargs)
         return self.environment(task, time_limit, arm_spec, tendon_layout, environment_kwargs)

@@ -39,7 +39,7 @@ import math
 import numpy as np
 
 from robostrich_suite.model import quadruped as quad
-from robostrich_suite.model import scenes
+from robostrich_suite import scenes
 from robostrich_suite.tasks import gait as gait_lib
 from robostrich_suite.tasks import reach
 

@@ -15,7 +15,7 @@ from dm_control import mjcf, mujoco
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite.model import quadruped as quad
-from robostrich_suite.tasks.conventions import PHYSICS_TIMESTEP
+from robostrich_suite.model.timesteps import PHYSICS_TIMESTEP
 
 
 # --- the immobile frame ----------------------------------------------------------------

@@ -4,11 +4,12 @@ set made with another arm is recognised as stale."""
 from __future__ import annotations
 
 import hashlib
+import warnings
 
 import numpy as np
 
+from robostrich_suite import scenes, targets
 from robostrich_suite.model import arm as arm_lib
-from robostrich_suite.model import scenes
 
 
 def model_fingerprint(spec: arm_lib.ArmSpec | None = None,
@@ -29,3 +30,20 @@ def compiled_fingerprint(model) -> str:
         digest.update(np.round(np.asarray(getattr(model, field), np.float64), 9).tobytes())
     digest.update(np.array([model.opt.timestep, model.opt.integrator], np.float64).tobytes())
     return digest.hexdigest()[:16]
+
+
+def warn_if_other_arm(spec=None, layout=None) -> bool:
+    """Warn (and return True) when the shipped targets were made with another arm than
+    ``spec``/``layout``: its level-head poses differ, so some targets may be out of reach
+    or not holdable with a level head."""
+    if spec is None and layout is None:
+        return False
+    shipped = str(targets.level_head_poses()["fingerprint"])
+    if model_fingerprint(spec, layout) == shipped:
+        return False
+    warnings.warn(
+        "the shipped targets were made with the default arm, not this arm spec/tendon layout; "
+        "some may be unreachable. Make targets for it with robostrich_suite.studies.target_generation.generate("
+        "..., spec=..., layout=..., path=FILE) and pass target_pool=training_targets(FILE).",
+        stacklevel=3)
+    return True

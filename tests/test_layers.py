@@ -1,0 +1,81 @@
+"""The package's layers import downwards only: model -> physics -> tasks -> domains, studies beside
+them, and robostrich_suite never imports the agent (a simulation user needs no JAX)."""
+import ast
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "robostrich_suite"
+# Each module's layer; a module may import from its own layer and the ones below it.
+LAYERS = ("utilities", "model", "physics", "tasks", "domains", "studies")
+TOP_LEVEL = {"cli": "utilities", "rerun_log": "utilities", "targets": "model", "physics": "physics",
+             "scenes": "physics", "fingerprint": "physics", "robostrich": "domains",
+             "robostrich_a1": "domains", "gym_adapter": "domains", "policies": "domains",
+             "xml_export": "domains", "benchmarking": "domains", "__init__": "domains"}
+
+
+def layer_of(module: str) -> str:
+    parts = module.split(".")[1:] or ["__init__"]
+    if parts[0] in ("model", "tasks", "studies"):
+        return parts[0]
+    return TOP_LEVEL[parts[0]]
+
+
+def modules():
+    for path in sorted(PACKAGE.rglob("*.py")):
+        name = ".".join(path.relative_to(ROOT).with_suffix("").parts)
+        yield name.removesuffix(".__init__"), path
+
+
+def imported(path: pathlib.Path):
+    """Every robostrich_suite or agents module `path` imports, at any depth (inside functions too)."""
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            yield from (a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            if node.module == "robostrich_suite":
+                yield from (f"robostrich_suite.{a.name}" for a in node.names)
+            else:
+                yield node.module
+
+
+def test_every_module_has_a_layer():
+    for module, _ in modules():
+        assert layer_of(module) in LAYERS, module
+
+
+def test_no_module_imports_a_higher_layer_or_the_agent():
+    wrong = []
+    for module, path in modules():
+        own = LAYERS.index(layer_of(module))
+        for target in imported(path):
+            if target.split(".")[0] == "agents":
+                wrong.append(f"{module} imports {target}")
+            elif target.startswith("robostrich_suite") and target != "robostrich_suite":
+                if LAYERS.index(layer_of(target)) > own:
+                    wrong.append(f"{module} ({layer_of(module)}) imports {target} ({layer_of(target)})")
+            elif target == "robostrich_suite" and own < LAYERS.index("domains"):
+                wrong.append(f"{module} imports the package's top")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_every_module_imports_with_the_agent_blocked():
+    """A user of the simulation alone: with `agents` unimportable, every module still imports."""
+    names = [m for m, _ in modules()]
+    code = ("import sys\nclass Block:\n    def find_spec(self, name, path=None, target=None):\n"
+            "        if name == 'agents' or name.startswith('agents.'):\n"
+            "            raise ImportError('agents is blocked')\n"
+            "sys.meta_path.insert(0, Block())\nimport importlib\n"
+            f"for name in {names!r}:\n    importlib.import_module(name)\nprint('imported', len({names!r}))\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                            env={"MUJOCO_GL": "egl", "PATH": "/usr/bin:/bin"})
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert f"imported {len(names)}" in result.stdout
+
+
+@pytest.mark.parametrize("module", ["robostrich_suite.model.arm", "robostrich_suite.physics"])
+def test_layer_map_is_not_vacuous(module):
+    assert layer_of(module) in ("model", "physics")
