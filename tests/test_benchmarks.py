@@ -36,7 +36,7 @@ def summary(success, position, attitude, steps=300, kinds=("heldout", "heldout_m
 
 @pytest.fixture(scope="session")
 def tool_env():
-    """XLA compiles dominate these tiny runs; a compilation cache that outlives the session makes reruns fast."""
+    """XLA compiles dominate these tiny runs; a compilation cache that outlives the test run makes reruns fast."""
     cache = os.environ.get("JAX_COMPILATION_CACHE_DIR") or os.path.join(tempfile.gettempdir(),
                                                                          "robostrich-tests-jax-cache")
     return {**os.environ, "MUJOCO_GL": "egl", "JAX_COMPILATION_CACHE_DIR": cache,

@@ -76,7 +76,7 @@ def test_evaluate_exits_zero_on_a_checkpoint(trained, tmp_path):
 
 
 def test_train_runs_on_the_quadruped_and_on_another_layout(tmp_path):
-    """issue 10: a plan on robostrich_a1 no longer falls through to dm_control; --layout names a layout."""
+    """A plan on robostrich_a1 no longer falls through to dm_control; --layout names a layout."""
     processes = {"a1": start("robostrich-train", *TINY_TRAIN, "--domain", "robostrich_a1", "--out", tmp_path / "a1"),
                  "layout": start("robostrich-train", *TINY_TRAIN, "--layout", "antagonist_pairs",
                                  "--out", tmp_path / "layout")}
@@ -191,7 +191,7 @@ def test_rejected_resume_leaves_the_run_unchanged(trained, tmp_path):
 
 
 def test_import_without_display_prints_no_glfw_error():
-    """No DISPLAY and no MUJOCO_GL: the package picks a headless backend itself (issue 11)."""
+    """No DISPLAY and no MUJOCO_GL: the package picks a headless backend itself."""
     env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "DISPLAY", "WAYLAND_DISPLAY")}
     result = subprocess.run([sys.executable, "-c", "import os, robostrich_suite; print(os.environ['MUJOCO_GL'])"],
                             env=env, capture_output=True, text=True, timeout=120)

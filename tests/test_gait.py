@@ -206,7 +206,7 @@ def test_trunk_height_schedule_rejects_nan_times():
 
 
 def test_gait_option_takes_a_path_or_a_gait_object_and_names_anything_else(tmp_path):
-    """What README says `gait=` accepts (issue 11); a standing task refuses a gait instead of ignoring it."""
+    """What README says `gait=` accepts; a standing task refuses a gait instead of ignoring it."""
     import robostrich_suite
     path = tmp_path / "trot.csv"
     gait.write_gait_file(path, *gait_generation.sample_trot())

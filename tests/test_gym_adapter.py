@@ -74,7 +74,7 @@ def test_step_after_the_episode_ended_asks_for_a_reset():
 
 
 def test_rgb_array_render_shows_the_arm_and_check_env_renders():
-    """render_mode='rgb_array' (issue 11: the adapter could not render); a real frame under EGL."""
+    """render_mode='rgb_array': a real frame under EGL."""
     import os
     if os.environ.get("MUJOCO_GL") != "egl":
         pytest.skip("renders under MUJOCO_GL=egl")

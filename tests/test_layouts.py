@@ -1,4 +1,4 @@
-"""Tendon-layout comparison (issue 13): layout files, the coverage metric, robostrich-layouts."""
+"""Tendon-layout comparison: layout files, the coverage metric, robostrich-layouts."""
 import csv
 import json
 import os

@@ -256,7 +256,7 @@ def test_bad_task_options_raise():
 
 
 def test_walk_tool_writes_a_recording_and_a_plot_into_its_out_directory(tmp_path, capsys, verify_rrd):
-    """--out is a directory, as for robostrich-movement and robostrich-workspace (issue 11)."""
+    """--out is a directory, as for robostrich-movement and robostrich-workspace."""
     walk.main(["--seconds", "0.4", "--tendons", "sine", "--out", str(tmp_path / "walk")])
     assert (tmp_path / "walk" / "walk.rrd").stat().st_size > 10_000
     assert (tmp_path / "walk" / "walk.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

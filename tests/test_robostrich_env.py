@@ -293,7 +293,7 @@ def test_lesson2_starts_fixed_and_lesson3_continues():
 
 def test_lesson3_continues_from_wherever_the_arm_was_reset():
     """A reset in mid-episode, and one after pickling (a checkpoint), continue from the live pose;
-    after forget_last_state, and for a task pickled with the older _last_state, as stated."""
+    after forget_last_state, from the fixed pose."""
     env = robostrich_suite.load("robostrich", "lesson3", task_kwargs=dict(random=0))
     env.reset()
     for _ in range(30):
@@ -308,16 +308,6 @@ def test_lesson3_continues_from_wherever_the_arm_was_reset():
     np.testing.assert_array_equal(unpickled.reset().observation["joint_angles"], env.reset().observation["joint_angles"])
     env.task.forget_last_state()
     np.testing.assert_array_equal(env.reset().observation["joint_angles"], np.zeros(18))
-    # An environment pickled by the code before the physics kept the pre-reset state: the task
-    # held the last pose as _last_state (None after a divergence or forget_last_state).
-    for last_state, continues in ((("qpos", "qvel", "act", "ctrl"), True), (None, False)):
-        state = dict(env.task.__dict__)
-        del state["_continues_from_physics"]
-        state["_last_state"] = last_state
-        task = object.__new__(type(env.task))
-        task.__setstate__(state)
-        assert task._continues_from_physics is continues
-        assert "_last_state" not in task.__dict__
 
 
 def test_track_visits_targets_in_order():

@@ -1,4 +1,4 @@
-"""What setup.py promises matches what its pinned dependencies need, and the README says the same (issue 11)."""
+"""What setup.py promises matches what its pinned dependencies need, and the README says the same."""
 import ast
 import importlib.metadata
 import pathlib
@@ -50,7 +50,7 @@ def test_readme_states_the_same_python_version():
 
 
 def test_readme_python_snippets_run_on_their_own():
-    """Each ```python block of the README runs in a fresh namespace: it imports what it uses (issue 11)."""
+    """Each ```python block of the README runs in a fresh namespace: it imports what it uses."""
     readme = (ROOT / "README.md").read_text()
     snippets = re.findall(r"```python\n(.*?)```", readme, flags=re.S)
     assert len(snippets) >= 2

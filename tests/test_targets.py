@@ -82,7 +82,7 @@ def test_another_arm_gets_a_warning_and_its_own_targets(tmp_path):
 
 def test_running_the_module_prints_no_runpy_warning():
     """`python -m robostrich_suite.studies.target_generation` without runpy's RuntimeWarning about
-    sys.modules: importing the package must not import the generation module (issue 11)."""
+    sys.modules: importing the package must not import the generation module."""
     import os
     import subprocess
     import sys

@@ -16,7 +16,7 @@ CONFIG = SACConfig(batch_size=64, hidden_sizes=(64, 64), learning_rate=1e-3, ini
                    her_ratio=0.5, relabel_rewards=True, critic_layer_norm=True)
 # Measured here at 24k steps: success 0 -> 11/27 held-out targets, median error 0.43 -> 0.068 m
 # (the same run without those improvements: 2/27, 0.18 m). With the default pre-tanh penalty
-# (0.1, tenth session), which pulls the policy toward mid-range inputs and so slows lesson 1's
+# (0.1), which pulls the policy toward mid-range inputs and so slows lesson 1's
 # first 24k steps: success 0 -> 6/27, median error 0.43 -> 0.135 m.
 STEPS = 24_000
 

@@ -50,7 +50,7 @@ class SACConfig:
     # Lesson 1 only: without hindsight goals there some seeds never learn the upper workspace
     # (84.5 -> 96.4 % held-out); in lessons 2-3 plain relabelling hurt (reached positions rarely had
     # a level head), and level goals (`her_level_goals`) gain precision but not success over 6 seeds
-    # (docs/learning.md, eighth session).
+    # (docs/learning.md).
     her_ratio: float = 0.5
     her_lessons: Tuple[str, ...] = ("lesson1",)
     # Relabel only with reached poses that are goals the lesson could set: in lessons 2-3 a

@@ -1,4 +1,4 @@
-"""How much of the paper's blue region an arm really holds level (issue 13's metric).
+"""How much of the paper's blue region an arm really holds level (the layout comparison's metric).
 
 The blue region of Fig. 6 is the set of kinematic head positions with the head
 level (:meth:`workspace.KinematicSamples.level`).  We count it in square cells of

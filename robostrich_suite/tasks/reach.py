@@ -2,22 +2,10 @@
 
 ``Reach`` is one curriculum lesson (paper Sec. 3.2): lesson 1 rewards only the
 position (eq. 9); lessons 2 and 3 reward position and head attitude (eq. 10).
-They differ in how an episode starts:
-
-* ``"fixed"``: the straight, upright pose at rest (lessons 1 and 2);
-* ``"continue"``: the final state of the previous episode (lesson 3), so the
-  agent learns to move between targets; the first episode, and any episode
-  after a divergence, starts fixed.  With ``stored_starts`` > 0, that share of
-  the episodes starts instead where the arm comes to rest holding one of
-  ``start_inputs`` (stored level poses), so the agent also learns to leave
-  poses it would never reach by itself.  With ``release_starts`` > 0, that share
-  of the episodes starts after the arm, from the last episode's final state, had
-  every tendon released (zero contraction) for a random time up to
-  ``release_time``: the states a neck passes through while it uncurls, which a
-  policy that holds its inputs never visits.  With ``fixed_stored_starts`` > 0,
-  that share of a ``"fixed"`` lesson's episodes (lessons 1-2) starts from a stored
-  pose as well, so what lessons 1-2 hand to lesson 3 already holds moves out of
-  lesson 3's starts (a neck uncurling among them).
+Lessons 1-2 start from the fixed pose, lesson 3 from where the last episode ended
+(:mod:`~robostrich_suite.tasks.starts`, with the other start distributions); targets come
+from a pool (:mod:`~robostrich_suite.tasks.target_samplers`).  Every option is a field of
+:class:`ReachConfig`, whose paper values :func:`default_config` gives.
 
 ``Track`` is the evaluation task of Fig. 7: a sequence of targets reached in
 order, one after another, within one episode.
@@ -28,6 +16,7 @@ the episode (discount 0) and is logged, instead of raising from the step.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -37,80 +26,19 @@ from dm_env import specs
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.tasks import randomization as randomization_lib
 from robostrich_suite.tasks import rewards
+from robostrich_suite.tasks.actions import check_action, validate_action  # noqa: F401 (the tasks' action)
+from robostrich_suite.tasks.starts import INITIAL_STATES, RELEASE_TIME, StartDistribution, check_initial_state  # noqa: F401
+from robostrich_suite.tasks.target_samplers import TARGET_SAMPLINGS, TargetSampler, as_targets  # noqa: F401
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG as DESIRED_ATTITUDE
 from robostrich_suite.tasks.conventions import LEVEL_TOLERANCE_DEG as ATTITUDE_TOLERANCE
 from robostrich_suite.tasks.conventions import POSITION_TOLERANCE
 
-INITIAL_STATES = ("fixed", "continue")
 REWARDS = ("lesson1", "lesson2")
-# How the next target is drawn from the pool: "uniform" (the paper), or "failures": each
-# target in proportion to its estimated failure rate, (failures + 1) / (tries + 2), judged
-# on the previous episode's final pose against what the lesson's reward asks for;
-# "continue_failures": "failures" in lessons whose episodes continue from the last pose (lesson 3),
-# "uniform" in fixed-start ones, so one option leaves lessons 1-2 the paper's.
-TARGET_SAMPLINGS = ("uniform", "failures", "continue_failures")
-# How long a stored start holds its inputs from the fixed pose before the episode begins: as
-# long as the evaluation's moving starts hold theirs (one 2 s episode), so the arm is at rest.
-STORED_START_SETTLE_TIME = 2.0  # s
-RELEASE_TIME = 1.0  # s: releasing a neck curled back by a turn brings it up to level in 0.8 s
-
-
-def _real_vector(action, size: int) -> np.ndarray:
-    """``action`` as an array of ``size`` real numbers (not copied), or a ValueError naming
-    what was expected and what came (a scalar must not silently drive every tendon, nor 8
-    values fail deep inside numpy)."""
-    array = np.asarray(action)
-    if array.dtype.kind not in "iuf":  # not bool, complex, str, object (None), ...
-        raise ValueError(f"action must be {size} real numbers (float), got dtype {array.dtype} "
-                         f"({type(action).__name__})")
-    if array.shape != (size,):
-        raise ValueError(f"action must have shape ({size},), got shape {array.shape}")
-    return array
-
-
-def validate_action(action, size: int) -> np.ndarray:
-    """``action`` as a new float64 vector of ``size`` real numbers, or a ValueError naming what
-    was expected and what came."""
-    return _real_vector(action, size).astype(np.float64)
-
-
-def _hold_before_episode(physics, inputs, seconds: float) -> None:
-    """Hold tendon ``inputs`` for ``seconds`` before an episode (stored and release starts); its
-    clock then starts at 0.  A divergence meanwhile leaves the fixed pose (logged like any other)."""
-    steps = int(round(seconds / physics.timestep()))
-    if steps < 1:
-        return
-    physics.set_arm_control(check_action(inputs, physics.arm_control_bounds()))
-    physics.step(steps)
-    if physics.divergence is not None:
-        physics.reset()
-    physics.data.time = 0.0
 
 
 def _length(vector: np.ndarray) -> float:
     """Euclidean length: np.linalg.norm's own formula, without its checks (a per-step path)."""
     return math.sqrt(vector.dot(vector))
-
-
-MAX_TARGET_DISTANCE = 1.5  # m from the origin of the targets' frame: no arm reaches farther
-
-
-def as_targets(targets, name: str) -> np.ndarray:
-    """(n, 2) finite head positions (x, z); one (2,) position is one target. Anything else (a
-    (4, 3) or (1, 4) array) is an error, not silently reshaped into other targets."""
-    array = np.asarray(targets, dtype=np.float64)
-    if array.shape == (2,):
-        array = array[None]
-    if array.ndim != 2 or array.shape[1] != 2 or len(array) == 0:
-        raise ValueError(f"{name} must be a non-empty (n, 2) array of (x, z) positions, got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must hold finite positions")
-    far = np.flatnonzero(np.linalg.norm(array, axis=1) > MAX_TARGET_DISTANCE)
-    if far.size:
-        raise ValueError(f"{name} holds {far.size} position(s) far outside any workspace, e.g. {array[far[0]].tolist()}: "
-                         f"more than {MAX_TARGET_DISTANCE} m from the origin (the arm is 0.67 m long, its base "
-                         "within 0.5 m of the frame's and the trunk's origin)")
-    return array
 
 
 def check_time_limit(time_limit) -> float:
@@ -120,159 +48,141 @@ def check_time_limit(time_limit) -> float:
     return float(time_limit)
 
 
-def check_action(action: np.ndarray, bounds, out: np.ndarray | None = None) -> np.ndarray:
-    """Reject actions of the wrong shape or type and NaN/inf; clip the rest into ``bounds``,
-    the (low, high) arrays ``physics.arm_control_bounds()`` gives.  The clipped action goes
-    into ``out`` where given (the simulation's controls: the per-step path), else a new array;
-    nothing is written unless the action is valid."""
-    low, high = bounds
-    array = _real_vector(action, len(low))
-    # One dot product is finite when every entry is (and small enough that squares stay
-    # finite, which real tendon inputs are); only otherwise look at each entry.
-    if not math.isfinite(array.dot(array)):
-        finite = np.isfinite(array)
-        if not finite.all():
-            bad = np.flatnonzero(~finite).tolist()
-            raise ValueError(f"action has non-finite values at indices {bad}: {array}")
-    # np.clip's result (in float64 whatever came), by two in-place steps: a third of its cost
-    if out is None:
-        out = np.empty(len(low))
-    np.maximum(array, low, out=out)
-    return np.minimum(out, high, out=out)
+@dataclasses.dataclass(frozen=True)
+class ReachConfig:
+    """Every option of a reaching task, with the paper's values as defaults (:func:`default_config`);
+    a lesson sets ``reward`` and ``initial_state``, the training defaults override others.
+
+    reward: ``"lesson1"`` (eq. 9) or ``"lesson2"`` (eq. 10).  initial_state, stored_starts,
+    fixed_stored_starts, start_inputs, release_starts, release_time: where episodes start
+    (:mod:`~robostrich_suite.tasks.starts`).  target_pool: (n, 2) head positions (x, z) to draw
+    targets from (None: :func:`robostrich_suite.targets.training_targets`); target_sampling: how
+    (:mod:`~robostrich_suite.tasks.target_samplers`).  position_tolerance, attitude_tolerance: d (m)
+    and a (deg) of eqs. 9-10; desired_attitude: the head attitude to hold (deg; 90 = level);
+    weights: lambda_1..lambda_4 (a ``RewardWeights`` or a dict of its fields); target_axes: the
+    world axes the targets are given in; randomization: a ``DomainRandomization`` (or a dict of
+    its fields) drawing new arm parameters every episode, None = off.
+    """
+    reward: str = "lesson2"
+    initial_state: str = "fixed"
+    target_pool: object = None
+    position_tolerance: float = POSITION_TOLERANCE
+    attitude_tolerance: float = ATTITUDE_TOLERANCE
+    desired_attitude: float = DESIRED_ATTITUDE
+    weights: object = None
+    target_axes: tuple = (0, 2)
+    randomization: object = None
+    target_sampling: str = "uniform"
+    stored_starts: float = 0.0
+    start_inputs: object = None
+    release_starts: float = 0.0
+    release_time: float = RELEASE_TIME
+    fixed_stored_starts: float = 0.0
+
+
+def default_config() -> ReachConfig:
+    """The reaching task's options as the paper has them (``dataclasses.replace`` to override)."""
+    return ReachConfig()
 
 
 class Reach(base.Task):
-    """Bring the head to a target position (and, from lesson 2, hold it level)."""
+    """Bring the head to a target position (and, from lesson 2, hold it level).
 
-    # Class-level defaults, so that an environment pickled before target sampling existed
-    # (a checkpoint's) still unpickles into a working task.
-    target_sampling = "uniform"
-    _target_index = None
-    _last_reached = None
-    stored_starts = 0.0
-    fixed_stored_starts = 0.0
-    start_inputs = None
-    release_starts = 0.0
-    release_time = RELEASE_TIME
-    _head_reading = None
-    _continues_from_physics = False  # see _continuing_state
-    _action_change = 0.0  # mean |change| of the tendon inputs at the last step (m), see RewardWeights
+    Built from a :class:`ReachConfig` (default :func:`default_config`) with any of its fields
+    overridden by keyword; it composes a :class:`~robostrich_suite.tasks.starts.StartDistribution`
+    and a :class:`~robostrich_suite.tasks.target_samplers.TargetSampler`."""
 
-    def __init__(self, reward: str = "lesson2", initial_state: str = "fixed",
-                 target_pool=None, position_tolerance: float = POSITION_TOLERANCE,
-                 attitude_tolerance: float = ATTITUDE_TOLERANCE,
-                 desired_attitude: float = DESIRED_ATTITUDE,
-                 weights: rewards.RewardWeights | dict | None = None,
-                 target_axes=(0, 2), randomization=None, target_sampling: str = "uniform",
-                 stored_starts: float = 0.0, start_inputs=None, release_starts: float = 0.0,
-                 release_time: float = RELEASE_TIME, fixed_stored_starts: float = 0.0, random=None):
-        """
-        Args:
-          reward: ``"lesson1"`` (eq. 9) or ``"lesson2"`` (eq. 10).
-          initial_state: ``"fixed"`` or ``"continue"`` (see the module doc).
-          target_pool: (n, 2) head positions (x, z) to draw targets from; defaults
-            to :func:`robostrich_suite.targets.training_targets`.
-          position_tolerance, attitude_tolerance: d (m) and a (deg) of eqs. 9-10.
-          desired_attitude: head attitude to hold (deg; 90 = level).
-          weights: lambda_1..lambda_4 (a ``RewardWeights`` or a dict of its fields).
-          target_axes: world axes of the head position the targets are given in.
-          randomization: a ``DomainRandomization`` (or a dict of its fields) to draw
-            new arm parameters every episode and add joint-angle noise; None = off.
-          target_sampling: ``"uniform"``, ``"failures"`` (targets the agent misses are
-            drawn more often) or ``"continue_failures"`` (that, in ``"continue"`` lessons
-            only); see ``TARGET_SAMPLINGS``.
-          stored_starts: share (0-1) of a ``"continue"`` lesson's episodes that start where
-            the arm comes to rest holding one of ``start_inputs`` (drawn uniformly) from the
-            fixed pose for ``STORED_START_SETTLE_TIME``; 0 (default): the paper's lesson 3.
-            Ignored by ``"fixed"`` lessons, so one option can serve a whole curriculum.
-          start_inputs: (n, tendons) tendon inputs for ``stored_starts`` and
-            ``fixed_stored_starts`` (the agent layer passes the lookup table's, minus the
-            evaluation's start poses).
-          release_starts: share (0-1) of a ``"continue"`` lesson's episodes (those that
-            continue from the last state) that start after every tendon was released for a
-            uniformly drawn time in [0, ``release_time``] s; 0 (default): the paper's lesson 3.
-          fixed_stored_starts: share (0-1) of a ``"fixed"`` lesson's episodes that start
-            from a stored pose as ``stored_starts`` ones do; 0 (default): the paper's
-            lessons 1-2. Ignored by ``"continue"`` lessons.
-        """
-        if reward not in REWARDS:
-            raise ValueError(f"unknown reward {reward!r}; use one of {REWARDS}")
-        if initial_state not in INITIAL_STATES:
-            raise ValueError(f"unknown initial_state {initial_state!r}; use one of {INITIAL_STATES}")
-        if target_sampling not in TARGET_SAMPLINGS:
-            raise ValueError(f"unknown target_sampling {target_sampling!r}; use one of {TARGET_SAMPLINGS}")
-        if target_pool is None:
+    def __init__(self, config: ReachConfig | None = None, random=None, **overrides):
+        config = dataclasses.replace(config or default_config(), **overrides)
+        if config.reward not in REWARDS:
+            raise ValueError(f"unknown reward {config.reward!r}; use one of {REWARDS}")
+        self.starts = StartDistribution(check_initial_state(config.initial_state), config.stored_starts,
+                                        config.fixed_stored_starts, config.start_inputs,
+                                        config.release_starts, config.release_time)
+        pool = config.target_pool
+        if pool is None:
             from robostrich_suite import targets
-            target_pool = targets.training_targets()
-        target_pool = as_targets(target_pool, "target_pool")
-        for name, value in (("position_tolerance", position_tolerance), ("attitude_tolerance", attitude_tolerance)):
+            pool = targets.training_targets()
+        self.sampler = TargetSampler(pool, config.target_sampling)
+        self._set_reward(config)
+        self._set_target_axes(config.target_axes)
+        randomization = config.randomization
+        if isinstance(randomization, dict):
+            randomization = randomization_lib.DomainRandomization(**randomization)
+        self.randomizer = (randomization_lib.Randomizer(randomization)
+                           if randomization is not None else None)
+        self.target_position = self.target_pool[0].copy()
+        self._last_reached = None
+        self._head_reading = None
+        self._continues_from_physics = False  # see _continuing_state
+        self._action_change = 0.0  # mean |change| of the tendon inputs at the last step (m), see RewardWeights
+        super().__init__(random=random)
+
+    def _set_reward(self, config: ReachConfig) -> None:
+        """Eq. 9 or 10's name, tolerances, desired attitude and weights, checked."""
+        for name in ("position_tolerance", "attitude_tolerance"):
+            value = getattr(config, name)
             if not (np.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be a positive finite number, got {value}")
-        if not np.isfinite(desired_attitude):
-            raise ValueError(f"desired_attitude must be a finite angle in degrees, got {desired_attitude}")
+        if not np.isfinite(config.desired_attitude):
+            raise ValueError(f"desired_attitude must be a finite angle in degrees, got {config.desired_attitude}")
+        weights = config.weights
         if isinstance(weights, dict):
             weights = rewards.RewardWeights(**weights)
-        for name, share in (("stored_starts", stored_starts), ("fixed_stored_starts", fixed_stored_starts)):
-            if not (np.isfinite(share) and 0.0 <= share <= 1.0):
-                raise ValueError(f"{name} must be a share between 0 and 1, got {share}")
-        if stored_starts > 0 or fixed_stored_starts > 0:
-            if start_inputs is None:
-                name = "stored_starts" if stored_starts > 0 else "fixed_stored_starts"
-                raise ValueError(f"{name} > 0 needs start_inputs: the (n, tendons) tendon inputs "
-                                 "of the stored poses to start from")
-            start_inputs = np.asarray(start_inputs, np.float64)
-            if start_inputs.ndim != 2 or len(start_inputs) == 0 or not np.all(np.isfinite(start_inputs)):
-                raise ValueError("start_inputs must be a non-empty (n, tendons) array of finite tendon "
-                                 f"inputs, got shape {start_inputs.shape}")
-        if not (np.isfinite(release_starts) and 0.0 <= release_starts <= 1.0):
-            raise ValueError(f"release_starts must be a share between 0 and 1, got {release_starts}")
-        if not (np.isfinite(release_time) and release_time > 0):
-            raise ValueError(f"release_time must be a positive finite time in seconds, got {release_time}")
-        self.stored_starts = float(stored_starts)
-        self.fixed_stored_starts = float(fixed_stored_starts)
-        self.release_starts = float(release_starts)
-        self.release_time = float(release_time)
-        self.start_inputs = start_inputs
-        self.reward_name = reward
-        self.initial_state = initial_state
-        self.target_sampling = target_sampling
-        self.set_target_pool(target_pool)
-        self.position_tolerance = float(position_tolerance)
-        self.attitude_tolerance = float(attitude_tolerance)
-        self.desired_attitude = float(desired_attitude)
+        self.reward_name = config.reward
+        self.position_tolerance = float(config.position_tolerance)
+        self.attitude_tolerance = float(config.attitude_tolerance)
+        self.desired_attitude = float(config.desired_attitude)
         self.weights = weights or rewards.RewardWeights()
+
+    def _set_target_axes(self, target_axes) -> None:
         self.target_axes = tuple(target_axes)
         if (len(self.target_axes) != 2 or len(set(self.target_axes)) != 2
                 or not all(isinstance(a, (int, np.integer)) and 0 <= a <= 2 for a in self.target_axes)):
             raise ValueError(f"target_axes must be two different world axes (0 = x, 1 = y, 2 = z), "
                              f"got {target_axes!r}")
         self._target_axes_index = physics_lib.as_slice(self.target_axes)
-        if isinstance(randomization, dict):
-            randomization = randomization_lib.DomainRandomization(**randomization)
-        self.randomizer = (randomization_lib.Randomizer(randomization)
-                           if randomization is not None else None)
-        self.target_position = self.target_pool[0].copy()
-        super().__init__(random=random)
+
+    # --- the parts it composes ---------------------------------------------------
+    @property
+    def initial_state(self) -> str:
+        return self.starts.initial_state
+
+    @property
+    def start_inputs(self):
+        return self.starts.start_inputs
+
+    @property
+    def target_sampling(self) -> str:
+        return self.sampler.sampling
+
+    @property
+    def target_pool(self) -> np.ndarray:
+        return self.sampler.pool
+
+    @target_pool.setter
+    def target_pool(self, targets) -> None:
+        self.set_target_pool(targets)
+
+    @property
+    def target_tries(self) -> np.ndarray:
+        return self.sampler.tries
+
+    @property
+    def target_failures(self) -> np.ndarray:
+        return self.sampler.failures
 
     # --- episode structure -------------------------------------------------
     def initialize_episode(self, physics):
         self._head_reading = None
         self._action_change = 0.0
         if self._samples_failures():  # before anything moves the physics
-            self._count_previous_episode()
+            self.sampler.record(self._last_reached)
+            self._last_reached = None
         if self.randomizer is not None:
             self.randomizer.apply(physics, self.random)
-        if self.initial_state == "continue":
-            last_state = self._continuing_state(physics)
-            if self.stored_starts and self.random.rand() < self.stored_starts:
-                self._settle_at_stored_input(physics)
-            elif last_state is not None:
-                self._restore_state(physics, last_state)
-                if self.release_starts and self.random.rand() < self.release_starts:
-                    released = np.zeros(len(physics.arm_control_bounds()[0]))  # every tendon at rest length
-                    _hold_before_episode(physics, released, self.random.uniform(0.0, self.release_time))
-        elif self.fixed_stored_starts and self.random.rand() < self.fixed_stored_starts:
-            self._settle_at_stored_input(physics)
+        self.starts.begin(physics, self.random, self._continuing_state(physics)
+                          if self.initial_state == "continue" else None)
         self.target_position = self.next_target()
         super().initialize_episode(physics)
         self._continues_from_physics = True
@@ -283,70 +193,26 @@ class Reach(base.Task):
         task's first episode, after a divergence or after :meth:`forget_last_state`."""
         return physics.state_before_reset if self._continues_from_physics else None
 
-    def __setstate__(self, state):
-        # A task pickled before the physics kept the pre-reset state (an older checkpoint's)
-        # held it as _last_state; its physics unpickles in that state, so continue from it.
-        if "_last_state" in state:
-            state["_continues_from_physics"] = state.pop("_last_state") is not None
-        self.__dict__.update(state)
-
-    @staticmethod
-    def _restore_state(physics, last_state):
-        qpos, qvel, act, command = last_state
-        with physics.reset_context():
-            physics.data.qpos[:] = qpos
-            physics.data.qvel[:] = qvel
-            if act.size:
-                physics.data.act[:] = act
-            physics.set_arm_control(command)  # the servos keep their command, as a real arm's would
-
-    def _settle_at_stored_input(self, physics):
-        """Hold one of ``start_inputs`` from the fixed pose until the arm is at rest, as the
-        evaluation's moving starts do; the episode's clock then starts at 0.  A divergence
-        while settling leaves the fixed pose (and is logged like any other)."""
-        inputs = self.start_inputs[self.random.randint(len(self.start_inputs))]
-        _hold_before_episode(physics, inputs, STORED_START_SETTLE_TIME)
-
-    def _count_previous_episode(self):
-        """Score the episode that just ended for ``target_sampling="failures"``: whether its
-        final pose (judged by ``get_reward``) did what the lesson asks."""
-        if self._target_index is not None and self._last_reached is not None:
-            self.target_tries[self._target_index] += 1
-            self.target_failures[self._target_index] += not self._last_reached
-        self._last_reached = None
-
     def _samples_failures(self) -> bool:
         """Whether the next target is drawn by failure rate (and episodes are scored for it)."""
-        return self.target_sampling == "failures" or (
-            self.target_sampling == "continue_failures" and self.initial_state == "continue")
+        return self.sampler.by_failures(self.initial_state)
 
     def set_target_pool(self, targets) -> None:
         """Draw the next episodes' targets from ``targets`` ((n, 2) or one (2,) position):
         an evaluation reuses one compiled environment for many targets this way. The
         failure counts of ``target_sampling="failures"`` start again from zero."""
-        self.target_pool = as_targets(targets, "target_pool")
-        self.target_tries = np.zeros(len(self.target_pool), np.int64)
-        self.target_failures = np.zeros(len(self.target_pool), np.int64)
-        self._target_index = None
+        self.sampler.set_pool(targets)
 
     def set_initial_state(self, initial_state: str) -> None:
         """``"fixed"`` or ``"continue"`` from the next episode on (see the module doc)."""
-        if initial_state not in INITIAL_STATES:
-            raise ValueError(f"unknown initial_state {initial_state!r}; use one of {INITIAL_STATES}")
-        self.initial_state = initial_state
+        self.starts.initial_state = check_initial_state(initial_state)
 
     def forget_last_state(self) -> None:
         """The next "continue" episode starts from the fixed pose (as after a divergence)."""
         self._continues_from_physics = False
 
     def next_target(self) -> np.ndarray:
-        if self._samples_failures():
-            failure_rate = (self.target_failures + 1.0) / (self.target_tries + 2.0)
-            self._target_index = int(self.random.choice(len(self.target_pool),
-                                                        p=failure_rate / failure_rate.sum()))
-        else:
-            self._target_index = int(self.random.randint(len(self.target_pool)))
-        return self.target_pool[self._target_index].copy()
+        return self.sampler.draw(self.random, self.initial_state)
 
     def action_spec(self, physics):
         """The tendon contractions (m), named after the tendons; nothing else is actuated."""

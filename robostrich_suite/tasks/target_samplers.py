@@ -1,0 +1,68 @@
+"""How a reaching task draws each episode's target from its pool.
+
+``"uniform"`` (the paper) draws every target alike; ``"failures"`` draws each in proportion to
+its estimated failure rate, (failures + 1) / (tries + 2), judged on the previous episode's
+final pose against what the lesson's reward asks for; ``"continue_failures"`` is ``"failures"``
+in lessons whose episodes continue from the last pose (lesson 3) and ``"uniform"`` in fixed-start
+ones, so one option leaves lessons 1-2 the paper's.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+TARGET_SAMPLINGS = ("uniform", "failures", "continue_failures")
+MAX_TARGET_DISTANCE = 1.5  # m from the origin of the targets' frame: no arm reaches farther
+
+
+def as_targets(targets, name: str) -> np.ndarray:
+    """(n, 2) finite head positions (x, z); one (2,) position is one target. Anything else (a
+    (4, 3) or (1, 4) array) is an error, not silently reshaped into other targets."""
+    array = np.asarray(targets, dtype=np.float64)
+    if array.shape == (2,):
+        array = array[None]
+    if array.ndim != 2 or array.shape[1] != 2 or len(array) == 0:
+        raise ValueError(f"{name} must be a non-empty (n, 2) array of (x, z) positions, got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must hold finite positions")
+    far = np.flatnonzero(np.linalg.norm(array, axis=1) > MAX_TARGET_DISTANCE)
+    if far.size:
+        raise ValueError(f"{name} holds {far.size} position(s) far outside any workspace, e.g. {array[far[0]].tolist()}: "
+                         f"more than {MAX_TARGET_DISTANCE} m from the origin (the arm is 0.67 m long, its base "
+                         "within 0.5 m of the frame's and the trunk's origin)")
+    return array
+
+
+class TargetSampler:
+    """A pool of (x, z) targets, the draw, and (for failure sampling) each target's tries and failures."""
+
+    def __init__(self, pool, sampling: str = "uniform"):
+        if sampling not in TARGET_SAMPLINGS:
+            raise ValueError(f"unknown target_sampling {sampling!r}; use one of {TARGET_SAMPLINGS}")
+        self.sampling = sampling
+        self.set_pool(pool)
+
+    def set_pool(self, targets) -> None:
+        """Draw from ``targets`` ((n, 2) or one (2,) position) from now on; the counts start again."""
+        self.pool = as_targets(targets, "target_pool")
+        self.tries = np.zeros(len(self.pool), np.int64)
+        self.failures = np.zeros(len(self.pool), np.int64)
+        self.index = None
+
+    def by_failures(self, initial_state: str) -> bool:
+        """Whether a lesson with this initial state draws by failure rate (and scores its episodes)."""
+        return self.sampling == "failures" or (self.sampling == "continue_failures" and initial_state == "continue")
+
+    def record(self, reached) -> None:
+        """Score the last drawn target: ``reached`` True or False (None: not judged, e.g. a divergence)."""
+        if self.index is not None and reached is not None:
+            self.tries[self.index] += 1
+            self.failures[self.index] += not reached
+
+    def draw(self, random, initial_state: str) -> np.ndarray:
+        """The next target (a copy), drawn with ``random``."""
+        if self.by_failures(initial_state):
+            failure_rate = (self.failures + 1.0) / (self.tries + 2.0)
+            self.index = int(random.choice(len(self.pool), p=failure_rate / failure_rate.sum()))
+        else:
+            self.index = int(random.randint(len(self.pool)))
+        return self.pool[self.index].copy()
