@@ -101,12 +101,16 @@ def per_seed(record: dict) -> str:
     return "; ".join(parts)
 
 
+def budget(record: dict) -> str:
+    """'curriculum SAC 600000, plain SAC ... 600000': the control steps each run trained."""
+    return ", ".join(f"{RUNS.get(label, label)} {'/'.join(str(v) for v in sorted(set(filter(None, values))))}"
+                     for label, values in record["seeds"]["steps"].items() if any(values))
+
+
 def render_record(record: dict) -> str:
     agg = record["seeds"]
-    steps = ", ".join(f"{RUNS.get(label, label)} {'/'.join(str(v) for v in sorted(set(filter(None, values))))}"
-                      for label, values in agg["steps"].items() if any(values))
     lines = [f"## {record['title']}", "", f"`{record['command']}` ({record['date']}, {record['machine']}); "
-             f"mean [min, max] over seeds {', '.join(map(str, agg['seeds']))}; control steps per run: {steps}."]
+             f"mean [min, max] over seeds {', '.join(map(str, agg['seeds']))}; control steps per run: {budget(record)}."]
     if record.get("note"):
         lines += ["", record["note"]]
     lines += [""] + seeds_table(record) + ["", "Curriculum SAC per seed (held-out fixed / moving / `track` / "
@@ -125,7 +129,7 @@ def render_page(records: list) -> str:
 def render_readme_table(record: dict) -> str:
     lines = [README_BEGIN,
              f"`{record['command']}` ({record['date']}, {record['machine']}), mean [min, max] over seeds "
-             f"{', '.join(map(str, record['seeds']['seeds']))}:", ""]
+             f"{', '.join(map(str, record['seeds']['seeds']))}; control steps per run: {budget(record)}:", ""]
     lines += seeds_table(record)
     lines += ["", README_END]
     return "\n".join(lines)

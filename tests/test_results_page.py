@@ -1,0 +1,69 @@
+"""Results live in one place: docs/results.md and the README's table are what the records give."""
+import json
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools"))
+
+import benchmark_seeds  # noqa: E402
+import results_page  # noqa: E402
+
+
+def _summary(success: float) -> dict:
+    report = {"success_rate": success, "precise_success_rate": success / 2, "position_error_median": 0.01,
+              "attitude_error_median": 1.0}
+    return {"runs": {"curriculum": {"heldout": report, "track": {**report, "success_rate": 2 / 3}},
+                     "lookup": {"heldout": {**report, "success_rate": 0.9}}},
+            "env_steps": {"curriculum": 600_000, "lookup": 0}}
+
+
+def test_readme_and_results_page_match_the_records():
+    done = subprocess.run([sys.executable, str(ROOT / "tools" / "results_page.py"), "--check"],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+
+
+def test_every_number_of_the_readme_table_comes_from_the_main_job_record():
+    record = {r["name"]: r for r in results_page.read_records()}[results_page.README_RECORD]
+    readme = (ROOT / "README.md").read_text()
+    block = readme[readme.index(results_page.README_BEGIN):readme.index(results_page.README_END)]
+    curriculum = record["seeds"]["results"]["curriculum"]["heldout"]["success_rate"]["mean"]
+    assert f"| curriculum SAC | held-out, fixed start | {curriculum * 100:.1f} %" in block
+
+
+def test_a_changed_number_makes_the_committed_text_stale(tmp_path):
+    records = results_page.read_records()
+    changed = json.loads(json.dumps(records))
+    main = next(r for r in changed if r["name"] == results_page.README_RECORD)
+    stats = main["seeds"]["results"]["curriculum"]["heldout"]["success_rate"]
+    stats["mean"] = stats["min"] = stats["max"] = 0.123
+    readme = (ROOT / "README.md").read_text()
+    expected = results_page.expected_files(changed, readme)
+    assert expected[results_page.README] != readme
+    assert expected[results_page.PAGE] != results_page.PAGE.read_text()
+    assert "12.3 %" in expected[results_page.PAGE]
+
+
+def test_a_record_shows_spread_per_seed_track_targets_and_the_command(tmp_path):
+    seeds_json = tmp_path / "seeds.json"
+    agg = benchmark_seeds.aggregate([_summary(1.0), _summary(0.9)], seeds=[4, 5], minutes=[10.0, None])
+    seeds_json.write_text(json.dumps(agg))
+    record = results_page.make_record("x", str(seeds_json), "A title", "python tools/benchmark_seeds.py --seeds 4,5",
+                                      date="2026-12-02")
+    text = results_page.render_record(record)
+    assert "95.0 % [90.0, 100.0]" in text  # mean [min, max] over the seeds
+    assert "| lookup (no learning) | held-out, fixed start | 90.0 % |" in text  # one value: no spread shown
+    assert "seed 4: 100.0 % / - / 2 of 3 track targets / 10.0 min" in text
+    assert "seed 5: 90.0 % / - / 2 of 3 track targets / time unknown" in text
+    assert "`python tools/benchmark_seeds.py --seeds 4,5` (2026-12-02," in text
+
+
+def test_a_file_that_is_not_a_benchmark_is_refused(tmp_path):
+    bad = tmp_path / "summary.json"
+    bad.write_text(json.dumps({"runs": {}}))
+    with pytest.raises(ValueError, match="not a tools/benchmark_seeds.py seeds.json"):
+        results_page.make_record("x", str(bad), "t", "c")
