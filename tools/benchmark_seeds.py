@@ -131,12 +131,12 @@ def run_seed(seed: int, seed_dir: str, passthrough) -> float:
 
 
 def seed_minutes(seed_dir: str, summary: dict):
-    """Minutes this tool measured; else the training's own per-session timings (None if neither)."""
+    """Minutes this tool measured; else the training's own timings of its last start (None if neither)."""
     path = os.path.join(seed_dir, TIMING_FILE)
     if os.path.exists(path):
         with open(path) as f:
             return json.load(f)["minutes"]
-    timings = summary.get("timings_this_session") or {}
+    timings = summary.get("timings") or {}
     return sum(t["seconds"] for t in timings.values()) / 60.0 if timings else None
 
 

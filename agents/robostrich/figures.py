@@ -236,36 +236,51 @@ def seed_groups_figure(groups: Dict[str, List[dict]], lookup: Dict[str, float] =
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), gridspec_kw={"width_ratios": [1.2, 1.2, 1.0]})
     last_step = 0
     for index, (label, seeds) in enumerate(groups.items()):
-        color = f"C{index}"
-        curves = [s["evals"] for s in seeds if s["evals"]]
-        if curves:
-            length = min(len(c) for c in curves)  # the steps every seed has reached
-            steps = np.array([r["env_steps"] for r in curves[0][:length]])
-            last_step = max(last_step, int(steps[-1]))
-            for ax, metric in ((axes[0], "success_rate"), (axes[1], "position_error_median")):
-                values = np.array([[r["summary"][metric] for r in c[:length]] for c in curves])
-                ax.plot(steps, values.mean(axis=0), "o-", color=color, ms=3,
-                        label=f"{label} (mean of {len(curves)} seeds)")
-                ax.fill_between(steps, values.min(axis=0), values.max(axis=0), color=color, alpha=0.15)
-        for offset, (kind, marker) in enumerate((("heldout", "o"), ("heldout_moving", "^"))):
-            rates = [(s["seed"], s["final"][kind]["success_rate"]) for s in seeds if kind in s.get("final", {})]
-            if not rates:
-                continue
-            x = index + (offset - 0.5) * 0.3
-            axes[2].scatter([x] * len(rates), [r for _, r in rates], color=color, marker=marker,
-                            label="fixed start" if index == 0 and kind == "heldout" else
-                            ("moving starts" if index == 0 else None), zorder=3)
-            for seed, rate in rates:
-                axes[2].annotate(str(seed), (x, rate), xytext=(4, 0), textcoords="offset points",
-                                 fontsize=7, va="center", color="0.3")
-            mean = float(np.mean([r for _, r in rates]))
-            axes[2].plot([x - 0.1, x + 0.1], [mean, mean], color=color, lw=2)
+        last_step = max(last_step, _plot_seed_curves(axes[:2], label, seeds, f"C{index}"))
+        _plot_final_rates(axes[2], index, seeds, f"C{index}")
     for kind, style in (("heldout", "--"), ("heldout_moving", ":")):
         if lookup and kind in lookup:
             where = "fixed start" if kind == "heldout" else "moving starts"
             axes[2].axhline(lookup[kind], color="k", ls=style, lw=1, label=f"lookup, {where}")
             if kind == "heldout":
                 axes[0].axhline(lookup[kind], color="k", ls=style, lw=1, label="lookup (all held-out targets)")
+    _dress_seed_groups(fig, axes, list(groups), lesson_boundaries, last_step)
+    return fig
+
+
+def _plot_seed_curves(axes, label: str, seeds: List[dict], color: str) -> int:
+    """(a) and (b): the mean over seeds with the min-max band; returns the last step every seed reached."""
+    curves = [s["evals"] for s in seeds if s["evals"]]
+    if not curves:
+        return 0
+    length = min(len(c) for c in curves)  # the steps every seed has reached
+    steps = np.array([r["env_steps"] for r in curves[0][:length]])
+    for ax, metric in zip(axes, ("success_rate", "position_error_median")):
+        values = np.array([[r["summary"][metric] for r in c[:length]] for c in curves])
+        ax.plot(steps, values.mean(axis=0), "o-", color=color, ms=3, label=f"{label} (mean of {len(curves)} seeds)")
+        ax.fill_between(steps, values.min(axis=0), values.max(axis=0), color=color, alpha=0.15)
+    return int(steps[-1])
+
+
+def _plot_final_rates(ax, index: int, seeds: List[dict], color: str) -> None:
+    """(c): every seed's final success from the fixed start and from moving starts, the mean as a bar."""
+    for offset, (kind, marker) in enumerate((("heldout", "o"), ("heldout_moving", "^"))):
+        rates = [(s["seed"], s["final"][kind]["success_rate"]) for s in seeds if kind in s.get("final", {})]
+        if not rates:
+            continue
+        x = index + (offset - 0.5) * 0.3
+        ax.scatter([x] * len(rates), [r for _, r in rates], color=color, marker=marker,
+                   label="fixed start" if index == 0 and kind == "heldout" else
+                   ("moving starts" if index == 0 else None), zorder=3)
+        for seed, rate in rates:
+            ax.annotate(str(seed), (x, rate), xytext=(4, 0), textcoords="offset points",
+                        fontsize=7, va="center", color="0.3")
+        mean = float(np.mean([r for _, r in rates]))
+        ax.plot([x - 0.1, x + 0.1], [mean, mean], color=color, lw=2)
+
+
+def _dress_seed_groups(fig, axes, labels_of_groups: List[str], lesson_boundaries, last_step: int) -> None:
+    """Limits, scales, lesson marks, ticks, titles and the shared legend of the seed-groups figure."""
     axes[0].set_ylim(*SUCCESS_LIMITS)
     axes[2].set_ylim(*SUCCESS_LIMITS)
     axes[1].set_yscale("log")
@@ -276,9 +291,9 @@ def seed_groups_figure(groups: Dict[str, List[dict]], lookup: Dict[str, float] =
     for ax in axes[:2]:
         ax.set_xlabel("environment steps")
         ax.ticklabel_format(axis="x", style="sci", scilimits=(3, 3))
-    axes[2].set_xticks(range(len(groups)))
-    axes[2].set_xticklabels([textwrap.fill(label, 12) for label in groups], fontsize=8)
-    axes[2].set_xlim(-0.6, len(groups) - 0.4)
+    axes[2].set_xticks(range(len(labels_of_groups)))
+    axes[2].set_xticklabels([textwrap.fill(label, 12) for label in labels_of_groups], fontsize=8)
+    axes[2].set_xlim(-0.6, len(labels_of_groups) - 0.4)
     for ax in axes:
         ax.grid(alpha=0.3)
     # (a) and (b) share their lines: one legend under both, off the data; (c) keeps its markers'.
@@ -296,7 +311,6 @@ def seed_groups_figure(groups: Dict[str, List[dict]], lookup: Dict[str, float] =
     fig.suptitle("Configurations over seeds: mean line, min-max band", fontsize=11)
     legend_rows = -(-(len(labels) + len(extra)) // 4)
     fig.tight_layout(rect=(0, 0.04 + 0.045 * legend_rows, 1, 1))
-    return fig
 
 
 def plot_seed_groups(groups: Dict[str, List[dict]], path: str, lookup: Dict[str, float] = None,

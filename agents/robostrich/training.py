@@ -580,10 +580,31 @@ def _supervise(context, specs, job, progress, workers, queue, active, ends):
 
 
 def main(argv=None):
+    """The main job: parse and check everything, train every run, evaluate, report; returns the summary."""
     args = build_parser().parse_args(argv)
+    setup = prepare(args, argv)
+    init = check_run_directory(args, setup)
+    lock = lock_run_directory(args.out)  # noqa: F841  (held until this process ends)
+    specs, runs = start_runs(args, argv, setup, init)
+    outcomes, lookup = train_all(args, setup, specs, runs)
+    return report(args, setup, specs, outcomes, lookup)
+
+
+@dataclasses.dataclass
+class _Setup:
+    """What the command line resolves to before anything is built."""
+    config: SACConfig
+    plan: list
+    domain: Domain
+    heldout_task: str
+    track_task: Optional[str]
+    run_plans: dict
+
+
+def prepare(args, argv) -> _Setup:
+    """Config, plan, domain, layout and task options from ``args``, every name and value checked."""
     config = config_from_args(args, argv)
     plan = plan_from_args(args)
-    total = sum(l.steps for l in plan)
     final = plan[-1]
     final_domain = Domain(final.domain)
     args.layout = resolve_layout(args.layout, final_domain)
@@ -598,83 +619,118 @@ def main(argv=None):
     track_task = evaluation.check_track_task(domain, args.track_task)
     run_plans = {"curriculum": plan}
     if args.baseline:
-        run_plans["baseline"] = [Lesson(final.domain, final.task, total)]
-    existing = [l for l in run_plans if os.path.exists(os.path.join(args.out, l, "checkpoint.pkl"))]
+        run_plans["baseline"] = [Lesson(final.domain, final.task, sum(l.steps for l in plan))]
+    return _Setup(config, plan, domain, heldout_task, track_task, run_plans)
+
+
+def check_run_directory(args, setup: _Setup) -> dict:
+    """Refuse a fresh run over checkpoints, a resume of nothing, and a resume of another
+    configuration or a damaged file, before anything is built or written; returns the
+    curriculum's --init-from (path and content hash), if any."""
+    existing = [l for l in setup.run_plans if os.path.exists(os.path.join(args.out, l, "checkpoint.pkl"))]
     if not args.resume and existing:
         raise ValueError(f"{args.out} already holds checkpoints ({', '.join(existing)}); "
                          "pass --resume to continue them or choose another --out")
     if args.resume and not existing:  # a typo in --out must not quietly start the whole job afresh
-        looked = ", ".join(os.path.join(l, "checkpoint.pkl") for l in run_plans)
+        looked = ", ".join(os.path.join(l, "checkpoint.pkl") for l in setup.run_plans)
         where = (f"{args.out} holds no checkpoint ({looked})" if os.path.isdir(args.out)
                  else f"{args.out} does not exist")
         raise FileNotFoundError(f"--resume: nothing to resume: {where}; check --out, or leave out --resume "
                                 "to start a fresh run")
-    init = {}  # the curriculum's --init-from: (path, content hash)
+    init = {}
     if args.init_from is not None:
         from agents.robostrich import transfer
-        source = transfer.check_source(args.init_from, plan, config, args.layout)
+        source = transfer.check_source(args.init_from, setup.plan, setup.config, args.layout)
         init = {"init_from": source.path, "init_digest": source.digest}
-    if args.resume:  # damaged or another configuration: refuse before building anything or touching a file
-        from agents import checkpoint
-        for label in existing:
-            path = os.path.join(args.out, label, "checkpoint.pkl")
-            stored = checkpoint.read_fingerprint(path)
-            if label == "curriculum":  # a started run's learner is in its checkpoint: --init-from may be left out
-                if init and stored.get("init_from") != init["init_digest"]:
-                    raise ValueError(f"{path} did not start from --init-from {args.init_from} "
-                                     + ("(nor from any checkpoint)" if "init_from" not in stored else
-                                        "(it started from another checkpoint, or that file has changed since)"))
-                init = {**init, "init_digest": stored["init_from"]} if "init_from" in stored else {}
-            expected = run_identity(run_plans[label], config, args.seed, args.task_kwargs, args.layout,
-                                    init.get("init_digest") if label == "curriculum" else None)
-            checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
-            for records in run_files(os.path.join(args.out, label))[1:]:
-                read_records(records)  # a damaged line other than a torn last one, named
-    lock = lock_run_directory(args.out)  # held until this process ends
+    for label in existing if args.resume else ():
+        init = _check_resumed(args, setup, label, init)
+    return init
 
-    boundaries = list(np.cumsum([l.steps for l in plan]))
-    eval_every = args.eval_every or max(1, total // 6)
-    eval_at = sorted(set(boundaries) | set(range(eval_every, total + 1, eval_every)))
 
-    specs = {label: RunSpec(label, tuple(run_plan), config, args.seed, os.path.join(args.out, label),
+def _check_resumed(args, setup: _Setup, label: str, init: dict) -> dict:
+    """One run's checkpoint against this command line (and its records' lines); the --init-from
+    a started curriculum recorded."""
+    from agents import checkpoint
+    path = os.path.join(args.out, label, "checkpoint.pkl")
+    stored = checkpoint.read_fingerprint(path)
+    if label == "curriculum":  # a started run's learner is in its checkpoint: --init-from may be left out
+        if init and stored.get("init_from") != init["init_digest"]:
+            raise ValueError(f"{path} did not start from --init-from {args.init_from} "
+                             + ("(nor from any checkpoint)" if "init_from" not in stored else
+                                "(it started from another checkpoint, or that file has changed since)"))
+        init = {**init, "init_digest": stored["init_from"]} if "init_from" in stored else {}
+    expected = run_identity(setup.run_plans[label], setup.config, args.seed, args.task_kwargs, args.layout,
+                            init.get("init_digest") if label == "curriculum" else None)
+    checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
+    for records in run_files(os.path.join(args.out, label))[1:]:
+        read_records(records)  # a damaged line other than a torn last one, named
+    return init
+
+
+def start_runs(args, argv, setup: _Setup, init: dict):
+    """The runs' specs (and, trained here, the runs themselves, restored on --resume); a run that
+    died before its first checkpoint loses its records; config.json. Returns (specs, runs)."""
+    specs = {label: RunSpec(label, tuple(run_plan), setup.config, args.seed, os.path.join(args.out, label),
                             args.checkpoint_every, args.task_kwargs, args.layout,
                             keep_lesson_checkpoints=args.keep_lesson_checkpoints,
                             **(init if label == "curriculum" else {}))  # the baseline starts from scratch
-             for label, run_plan in run_plans.items()}
-    workers = args.workers if args.stop_at_step is None else 1  # the kill hook raises in this process
-    parallel = workers > 1 and len(specs) > 1
+             for label, run_plan in setup.run_plans.items()}
     # Sequential: build (and restore) every run here; parallel: the workers do, once each.
-    runs = {} if parallel else {label: spec.build(restore=args.resume) for label, spec in specs.items()}
+    runs = {} if _parallel(args, specs) else {label: spec.build(restore=args.resume) for label, spec in specs.items()}
     # Every checkpoint is checked: only now change the run directory (a rejected resume leaves it as it was).
     for spec in specs.values():
         checkpoint_path, metrics_path, evals_path = run_files(spec.run_dir)
         if not (args.resume and os.path.exists(checkpoint_path)):
-            for p in (metrics_path, evals_path):  # a run that died before its first checkpoint
+            for p in (metrics_path, evals_path):
                 if os.path.exists(p):
                     os.unlink(p)
     evaluation.write_json(os.path.join(args.out, "config.json"), {
-        "argv": sys.argv if argv is None else list(argv), "config": config.to_dict(),
+        "argv": sys.argv if argv is None else list(argv), "config": setup.config.to_dict(),
         "task_kwargs": args.task_kwargs, "layout": args.layout,
         "init_from": {"path": init.get("init_from", _previous_init_path(args.out)), "sha256": init["init_digest"]}
         if init else None,
-        "plans": {k: format_plan(v) for k, v in run_plans.items()}, "seed": args.seed})
+        "plans": {k: format_plan(v) for k, v in setup.run_plans.items()}, "seed": args.seed})
+    return specs, runs
 
-    out_eval = os.path.join(args.out, "evaluation")
-    job = RunJob(domain=domain, heldout_task=heldout_task, track_task=track_task, eval_at=tuple(eval_at),
-                 num_eval_targets=args.num_eval_targets, final_eval_targets=args.final_eval_targets,
-                 out_eval=out_eval, record=not args.no_rerun, stop_at_step=args.stop_at_step)
+
+def _workers(args) -> int:
+    return args.workers if args.stop_at_step is None else 1  # the kill hook raises in this process
+
+
+def _parallel(args, specs) -> bool:
+    return _workers(args) > 1 and len(specs) > 1
+
+
+def train_all(args, setup: _Setup, specs: dict, runs: dict):
+    """Train and evaluate every run, here or one per worker, and the lookup; (outcomes, lookup reports)."""
+    total = sum(l.steps for l in setup.plan)
+    eval_every = args.eval_every or max(1, total // 6)
+    eval_at = sorted(set(_boundaries(setup.plan)) | set(range(eval_every, total + 1, eval_every)))
+    job = RunJob(domain=setup.domain, heldout_task=setup.heldout_task, track_task=setup.track_task,
+                 eval_at=tuple(eval_at), num_eval_targets=args.num_eval_targets,
+                 final_eval_targets=args.final_eval_targets, out_eval=os.path.join(args.out, "evaluation"),
+                 record=not args.no_rerun, stop_at_step=args.stop_at_step)
     progress = Progress(sum(spec.total_steps for spec in specs.values()), enabled=not args.quiet)
     progress.bar and progress.bar.update(sum(r.loop.env_steps for r in runs.values()))
     try:
-        if parallel:  # the lookup's evaluation joins the workers' queue (a run's core once it is done)
-            jobs = {**specs, LOOKUP_LABEL: LookupSpec()} if domain.is_arm else specs
-            outcomes = _train_in_parallel(jobs, job, progress, workers)
-            lookup = outcomes.pop(LOOKUP_LABEL)["reports"] if domain.is_arm else None
+        if _parallel(args, specs):  # the lookup's evaluation joins the workers' queue (a run's core once it is done)
+            jobs = {**specs, LOOKUP_LABEL: LookupSpec()} if setup.domain.is_arm else specs
+            outcomes = _train_in_parallel(jobs, job, progress, _workers(args))
+            lookup = outcomes.pop(LOOKUP_LABEL)["reports"] if setup.domain.is_arm else None
         else:
             outcomes = {label: train_and_evaluate(run, job, progress) for label, run in runs.items()}
             lookup = LookupSpec().evaluate(job)
     finally:
         progress.close()
+    return outcomes, lookup
+
+
+def _boundaries(plan) -> list:
+    return list(np.cumsum([l.steps for l in plan]))
+
+
+def report(args, setup: _Setup, specs: dict, outcomes: dict, lookup) -> dict:
+    """Figures, the training curves' recording and summary.json (printed); returns the summary."""
     finals = {label: o["reports"] for label, o in outcomes.items()}
     if lookup is not None:  # the no-learning bar, beside the agents
         finals["lookup"] = lookup
@@ -685,9 +741,9 @@ def main(argv=None):
         from agents.robostrich import figures
         os.makedirs(os.path.join(args.out, "figures"), exist_ok=True)
         figures.plot_learning_curves(metrics, evals, os.path.join(args.out, "figures", "learning_curves.png"),
-                                     lesson_boundaries=boundaries[:-1],
+                                     lesson_boundaries=_boundaries(setup.plan)[:-1],
                                      baselines={"lookup": lookup["heldout"]["summary"]} if lookup else None)
-        if track_task:
+        if setup.track_task:
             figures.plot_track({l: f["track"] for l, f in finals.items()},
                                os.path.join(args.out, "figures", "track.png"))
     if not args.no_rerun:
@@ -696,7 +752,7 @@ def main(argv=None):
     summary = {"runs": {label: {k: f[k]["summary"] for k in f} for label, f in finals.items()},
                "env_steps": {label: o["env_steps"] for label, o in outcomes.items()},
                "updates": {label: o["updates"] for label, o in outcomes.items()},
-               "timings_this_session": {label: o["timing"] for label, o in outcomes.items() if o["timing"]}}
+               "timings": {label: o["timing"] for label, o in outcomes.items() if o["timing"]}}
     evaluation.write_json(os.path.join(args.out, "summary.json"), summary)
     print(json.dumps(summary["runs"], indent=1))
     return summary

@@ -13,21 +13,20 @@ class SACConfig:
     fingerprint, so a checkpoint is never resumed under different settings.
     """
 
-    # The main job's defaults (robostrich-train generates its flags from these fields); the
-    # measurements behind each choice are in docs/learning.md. SACConfig.paper_sac() gives
-    # the paper's / Acme's plain SAC.
+    # Defaults chosen by measurement (docs/learning.md; a training command may generate its flags
+    # from these fields). SACConfig.paper_sac() gives the paper's / Acme's plain SAC.
     batch_size: int = 64
     learning_rate: float = 1e-3  # critics, actor and temperature alike
     discount: float = 0.99
     tau: float = 0.005  # Polyak rate of the target critics
     # The entropy the temperature steers the policy to: `target_entropy` if given, else
     # `target_entropy_per_action` x |A|. Acme's -1 per action leaves an exploration noise of about
-    # 9 % of each tendon's half-range, where the arm needs its inputs right to about 1 %: -2
-    # (about 3 %) raised held-out success from 76.5 to 90.1 % on antagonist_pairs (docs/learning.md).
+    # 9 % of each action's half-range; -2 (about 3 %) suits tasks that need their actions right to
+    # about 1 % (docs/learning.md).
     target_entropy: Optional[float] = None
     target_entropy_per_action: float = -2.0
-    # Acme starts at 1; on the arm's rewards (about -3 per control step) that entropy bonus
-    # outweighs the task for most of a short run, so start low and let the loss raise it.
+    # Acme starts at 1; on rewards of a few units per step that entropy bonus outweighs the task
+    # for most of a short run, so start low and let the loss raise it.
     init_temperature: float = 0.01
     hidden_sizes: Tuple[int, ...] = (64, 64)
     min_replay_size: int = 1_000
@@ -36,36 +35,29 @@ class SACConfig:
     # `env_steps_per_call` agent steps (transitions): update-to-data ratio = their quotient.
     updates_per_call: int = 4
     env_steps_per_call: int = 4
-    # The agent acts every `action_repeat` control steps (0.008 s each).
+    # The agent acts every `action_repeat` control steps.
     action_repeat: int = 1
     reward_scale: float = 1.0
     log_std_min: float = -5.0
     log_std_max: float = 2.0
     # Agent improvements beyond the paper's SAC (paper_sac() turns them off).
     critic_layer_norm: bool = True  # LayerNorm in every hidden layer of both critics
-    # Hindsight relabelling (HER, "future" strategy) on tasks whose reward is a function of the
-    # achieved head pose and the goal (robostrich's Reach; other tasks get none): this fraction of
-    # every sampled batch gets a goal the head reached later in the same episode, with the reward
-    # recomputed exactly. `her_lessons` names the lesson tasks that get it (empty = every task).
-    # Lesson 1 only: without hindsight goals there some seeds never learn the upper workspace
-    # (84.5 -> 96.4 % held-out); in lessons 2-3 plain relabelling hurt (reached positions rarely had
-    # a level head), and level goals (`her_level_goals`) gain precision but not success over 6 seeds
-    # (docs/learning.md).
+    # Hindsight relabelling (HER, "future" strategy) on tasks with the goal interface (agents/goals.py;
+    # other tasks get none): this fraction of every sampled batch gets a goal reached later in the
+    # same episode, with the reward recomputed exactly. `her_lessons` names the lesson tasks that
+    # get it (empty = every task); why the first lesson only: docs/learning.md.
     her_ratio: float = 0.5
     her_lessons: Tuple[str, ...] = ("lesson1",)
-    # Relabel only with reached poses that are goals the lesson could set: in lessons 2-3 a
-    # level head (within the attitude tolerance), so hindsight goals there are all level-head
-    # targets; lesson 1's eq. 9 ignores the attitude, so there every reached position is one.
+    # Relabel only with reached poses that are goals the lesson could set (within the task's
+    # attitude tolerance where its reward asks for one; GoalRelabeler.settable).
     her_level_goals: bool = False
-    # Lessons that train with `long_horizon_discount` instead of `discount` (empty: none). Moving
-    # between targets (lesson 3) can mean swinging the neck through a whole turn, which takes the
-    # arm longer than settling from the fixed start; 0.99 at 125 Hz looks 0.8 s ahead, 0.995 1.6 s.
+    # Lessons that train with `long_horizon_discount` instead of `discount` (empty: none), for
+    # lessons whose manoeuvres take longer than the discount looks ahead (0.99 at 125 Hz: 0.8 s).
     long_horizon_lessons: Tuple[str, ...] = ()
     long_horizon_discount: float = 0.995
     # Lessons that train toward `exploration_target_entropy_per_action` x |A| instead of the
     # target entropy above (empty: none): wider noise for a manoeuvre the policy's narrow noise
-    # never tries (uncurling the neck through a whole turn), or narrower noise where precision
-    # matters more than search (the main job's lesson 3 on robostrich: agents/robostrich/training.py).
+    # never tries, or narrower noise where precision matters more than search.
     exploration_lessons: Tuple[str, ...] = ()
     exploration_target_entropy_per_action: float = -1.0
     # ... and explore there with noise correlated over control steps (AR(1) coefficient per step
@@ -76,34 +68,32 @@ class SACConfig:
     # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
     # replay then carry lesson-2 rewards instead of the ones they were collected with.
     relabel_rewards: bool = True
-    # Residual policy on the lookup baseline (agents/robostrich/lookup.py) on tasks with a target_position
-    # observation: the action is the lookup's stored input plus this fraction of each tendon's
-    # half-range times the policy's output (0 = off: the policy outputs the whole input).
+    # Residual policy on a base policy the builder is given: the action is the base's plus this
+    # fraction of each action's half-range times the policy's output (0 = off: the policy
+    # outputs the whole action).
     residual_scale: float = 0.0
     # Weight of a penalty on the squared deterministic action in the actor loss (times the
     # critic's mean |Q|, as TD3+BC): keeps a residual policy at its base unless the critic
     # clearly prefers a correction (0 = off, plain SAC's actor loss; 0.4 is TD3+BC's alpha = 2.5).
     action_anchor: float = 0.0
     # Weight of a penalty on the squared pre-tanh mean of the policy in the actor loss (the
-    # original SAC code's mean regulariser, 1e-3 there; 0 = off, plain SAC). A tendon whose
-    # mean sits deep in the tanh's saturation gets almost no gradient from the critic (seed 0's
-    # tendon 0 at 2.9: 1 - tanh^2 = 0.012); this pulls it back where the critic can move it.
-    # 0.1 on seeds 0-2 (same machine, paired): moving starts 77.3 -> 88.4 %, track 5 -> 8 of 9
-    # targets, within 1 cm and 2 deg 56 -> 80 % (docs/learning.md).
+    # original SAC code's mean regulariser, 1e-3 there; 0 = off, plain SAC). An action whose
+    # mean sits deep in the tanh's saturation gets almost no gradient from the critic (at 2.9:
+    # 1 - tanh^2 = 0.012); this pulls it back where the critic can move it (docs/learning.md).
     pre_tanh_penalty: float = 0.1
     # Evaluate (and deploy) an exponential moving average of the policy's parameters, updated
     # with this rate after every gradient step (0 = off: the last policy, as the paper). The
     # agent still explores with its current policy, so training is unchanged bit for bit; the
     # average smooths the update-to-update wobble that moves a held-out target in or out of
-    # the tolerance from one evaluation to the next: 1e-4 (the last ~10k updates) raised
-    # held-out success from 93.2 to 96.0 % on the same 4 training runs (docs/learning.md).
+    # the tolerance from one evaluation to the next: 1e-4 is about the last 10k updates
+    # (docs/learning.md).
     policy_average: float = 1e-4
     # ... but early on, while 1 / policy_average is more updates than the run has made, the
     # average spans about this fraction of the updates so far (rate max(policy_average,
     # 1 / (1 + fraction * updates))) instead of keeping the initial policy's weight: with a
     # plain EMA at 1e-4, 15k updates (cartpole/swingup's 100k steps) leave 22 % of the
     # average at the random initial policy (275 against 866 by the last policy); 0 = the
-    # plain EMA.  From 100k updates on the rate is policy_average itself (the arm's 479k-update runs).
+    # plain EMA.  From 100k updates on the rate is policy_average itself.
     policy_average_fraction: float = 0.1
 
     # Fields that name lesson tasks (tuples here, lists in a fingerprint).
@@ -119,7 +109,7 @@ class SACConfig:
 
     def __post_init__(self):
         """Every field checked here, where it is owned: a bad value fails when the config is made
-        (robostrich-train names the flag), not as a NaN loss or a JAX error after training began."""
+        (a training command names the flag), not as a NaN loss or a JAX error after training began."""
         for name, limit in self.LIMITS.items():
             value, low = getattr(self, name), 0 if name == "min_replay_size" else 1
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= limit:
@@ -154,7 +144,7 @@ class SACConfig:
             if not 0.0 < getattr(self, name) <= 1.0:
                 raise ValueError(f"{name} must be in (0, 1], got {getattr(self, name)}")
         if self.residual_scale > 0 and self.her_ratio > 0:
-            raise ValueError("residual_scale and her_ratio do not mix: a relabelled goal changes the lookup's "
+            raise ValueError("residual_scale and her_ratio do not mix: a relabelled goal changes the base policy's "
                              "base action, so the stored residual would no longer mean what it did "
                              "(pass her_ratio=0, --her-ratio 0)")
         for name in ("target_entropy_per_action", "exploration_target_entropy_per_action"):

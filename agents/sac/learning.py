@@ -68,9 +68,8 @@ def average_rate(config: SACConfig, updates):
     return jnp.maximum(config.policy_average, 1.0 / (1.0 + config.policy_average_fraction * updates))
 
 
-def make_update_fn(networks: SACNetworks, config: SACConfig):
-    """Returns update(state, batch) -> (state, metrics) for ONE gradient step (not jitted)."""
-    policy_opt, q_opt, alpha_opt = make_optimizers(config)
+def make_loss_fns(networks: SACNetworks, config: SACConfig):
+    """(critic_loss, actor_loss, alpha_loss): eqs. 6, 7 and 8 of SAC with this config's additions."""
     target_entropy = config.resolved_target_entropy(networks.action_size)
 
     def critic_loss(q_params, target_q_params, policy_params, alpha, batch, key):
@@ -101,6 +100,14 @@ def make_update_fn(networks: SACNetworks, config: SACConfig):
     def alpha_loss(log_alpha, log_prob):
         # eq. 8: raise alpha when the entropy -log_prob falls below the target.
         return jnp.mean(-jnp.exp(log_alpha) * jax.lax.stop_gradient(log_prob + target_entropy))
+
+    return critic_loss, actor_loss, alpha_loss
+
+
+def make_update_fn(networks: SACNetworks, config: SACConfig):
+    """Returns update(state, batch) -> (state, metrics) for ONE gradient step (not jitted)."""
+    policy_opt, q_opt, alpha_opt = make_optimizers(config)
+    critic_loss, actor_loss, alpha_loss = make_loss_fns(networks, config)
 
     def update(state: TrainingState, batch: Transitions):
         key, k_critic, k_actor = jax.random.split(state.key, 3)

@@ -1,0 +1,40 @@
+"""The agent's shape: generic modules that name no robot, no function longer than a screen, and
+checkpoints that say which format they are."""
+import ast
+import pathlib
+import re
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+GENERIC = sorted(p for p in (ROOT / "agents").rglob("*.py") if "robostrich" not in p.relative_to(ROOT).parts)
+# Words of the robot and its simulator that a generic agent has no business knowing.
+ROBOT_WORDS = re.compile(r"robostrich|mujoco|dm_control|tendon|trunk|geom|quadruped|lookup", re.IGNORECASE)
+MAX_FUNCTION_LINES = 60
+
+
+def test_generic_agent_modules_name_no_robot_and_import_no_simulator():
+    assert len(GENERIC) >= 10, [p.name for p in GENERIC]  # sac/*, actors, replay, loop, curriculum, ...
+    found = [f"{p.relative_to(ROOT)}:{n}: {line.strip()}" for p in GENERIC
+             for n, line in enumerate(p.read_text().splitlines(), 1) if ROBOT_WORDS.search(line)]
+    assert not found, "\n".join(found)
+
+
+def test_no_function_is_longer_than_a_screen():
+    long = []
+    for path in list((ROOT / "agents").rglob("*.py")) + list((ROOT / "robostrich_suite").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                lines = node.end_lineno - node.lineno + 1
+                if lines > MAX_FUNCTION_LINES:
+                    long.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name}: {lines} lines")
+    assert not long, "\n".join(long)
+
+
+def test_no_legacy_shims_remain():
+    """Older checkpoints are refused by their format version, not translated: no code for them."""
+    hits = []
+    for path in list((ROOT / "agents").rglob("*.py")) + list((ROOT / "robostrich_suite").rglob("*.py")):
+        for n, line in enumerate(path.read_text().splitlines(), 1):
+            # dm_control's own `legacy_step` attribute is its API, not ours
+            if "legacy" in line.lower() and "legacy_step" not in line and "legacy step" not in line:
+                hits.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
+    assert not hits, "\n".join(hits)
