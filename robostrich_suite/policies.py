@@ -22,6 +22,7 @@ import zipfile
 
 import numpy as np
 
+from robostrich_suite import files
 from robostrich_suite import fingerprint as fingerprint_lib
 
 FORMAT_VERSION = 1
@@ -99,10 +100,8 @@ class Policy:
                       action_high=self.action_high)
         meta = {"format_version": FORMAT_VERSION, "fingerprint": self.fingerprint,
                 "observation_layout": [list(item) for item in self.observation_layout], "info": self.info}
-        tmp = path.with_name(path.name + ".tmp")
-        with open(tmp, "wb") as f:
+        with files.replaced_atomically(path) as f:
             np.savez_compressed(f, meta=np.array(json.dumps(meta)), **arrays)
-        tmp.replace(path)
 
 
 def read_policy(path) -> Policy:

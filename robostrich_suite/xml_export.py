@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import pathlib
 
+from robostrich_suite import files
 from robostrich_suite import cli as cli_lib
 
 
@@ -34,7 +35,7 @@ def export(directory: pathlib.Path) -> list[pathlib.Path]:
     written = []
     for name, generate in generators().items():
         path = directory / name
-        path.write_text(generate())
+        files.write_text(path, generate())
         written.append(path)
     return written
 

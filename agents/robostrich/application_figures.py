@@ -13,6 +13,8 @@ import matplotlib.patches as mpatches  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from robostrich_suite import files  # noqa: E402
+
 COLORS = {"trained": "tab:blue", "reference": "tab:green", "zero": "tab:gray", "lookup": "tab:orange"}
 
 
@@ -22,7 +24,7 @@ def _color(label: str, i: int) -> str:
 
 def _save(fig, path: Optional[str]):
     if path is not None:
-        fig.savefig(path, dpi=110)
+        files.save_figure(fig, path, dpi=110)
         plt.close(fig)
     return fig
 

@@ -17,6 +17,7 @@ from typing import Optional
 
 import numpy as np
 
+from robostrich_suite import files
 from agents.robostrich import probes
 from agents.robostrich.runs import make_environment
 from agents.robostrich.domains import MOVING_START_TASK, TRACK_TASK, as_domain
@@ -280,11 +281,8 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
 
 
 def write_text(path: str, text: str) -> None:
-    """Readers never see a half-written file: write beside it, then rename."""
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    """Readers never see a half-written file (robostrich_suite.files)."""
+    files.write_text(path, text)
 
 
 def write_json(path: str, obj) -> None:

@@ -15,6 +15,7 @@ import matplotlib.transforms as mtransforms  # noqa: E402
 import numpy as np  # noqa: E402
 
 from agents.robostrich import probes  # noqa: E402
+from robostrich_suite import files  # noqa: E402
 
 # A rate: always its whole range, so 0 % reads as 0 %; room above 1 for the lesson names.
 SUCCESS_LIMITS = (-0.03, 1.1)
@@ -33,7 +34,7 @@ def _smooth(x, n):
 
 
 def _save(fig, path: str) -> None:
-    fig.savefig(path, dpi=110)
+    files.save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 

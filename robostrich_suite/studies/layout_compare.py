@@ -31,6 +31,7 @@ import pathlib
 import time
 
 
+from robostrich_suite import files
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import targets
 from robostrich_suite.model import arm as arm_lib
@@ -248,7 +249,7 @@ def markdown_table(rows) -> str:
 
 def write_csv(path: pathlib.Path, rows) -> None:
     keys = list(dict.fromkeys(key for row in rows for key in row))
-    with open(path, "w", newline="") as f:
+    with files.replaced_atomically(path, "w") as f:
         writer = csv.DictWriter(f, fieldnames=keys)
         writer.writeheader()
         writer.writerows(rows)
@@ -331,7 +332,7 @@ def report(args, cases, region, results) -> pathlib.Path:
     rows = [r["row"] for r in results]
     args.out.mkdir(parents=True, exist_ok=True)
     table = markdown_table(rows)
-    (args.out / "layouts.md").write_text(
+    files.write_text(args.out / "layouts.md",
         f"Blue region: {len(region.head_position)} level heads among {args.kinematic_samples} "
         f"kinematic samples, {region.num_cells} cells of {coverage_lib.CELL_SIZE * 100:g} cm; "
         f"{args.random_samples} random + {len(region.head_position)} sought poses per layout.\n\n"

@@ -6,6 +6,7 @@ import pathlib
 
 import numpy as np
 
+from robostrich_suite import files
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite import scenes
 from robostrich_suite.studies import coverage as coverage_lib
@@ -128,6 +129,6 @@ def plot(cases, region: coverage_lib.BlueRegion, results, path) -> pathlib.Path:
     fig.suptitle("Tendon layouts on the Table 1 links: blue region of Fig. 6 held level "
                  "(top), routing on the straightened neck (bottom)", fontsize=10)
     fig.tight_layout(rect=(0, 0.08, 1, 0.96))
-    fig.savefig(path, dpi=140)
+    files.save_figure(fig, path, dpi=140)
     plt.close(fig)
     return path

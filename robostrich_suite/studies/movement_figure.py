@@ -6,6 +6,7 @@ import pathlib
 
 import numpy as np
 
+from robostrich_suite import files
 from robostrich_suite.studies import movement as movement_lib
 
 
@@ -107,6 +108,6 @@ def plot_movement(movement: movement_lib.Movement, path: str | pathlib.Path, num
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig = movement_figure(movement, num_sticks)
-    fig.savefig(path, dpi=120)
+    files.save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path

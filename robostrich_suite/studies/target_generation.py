@@ -20,6 +20,7 @@ import pathlib
 
 import numpy as np
 
+from robostrich_suite import files
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import targets
 from robostrich_suite import fingerprint as fingerprint_lib
@@ -129,15 +130,9 @@ def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str) -> int:
     of the arm with ``fingerprint``; returns how many.  Readers of ``path`` see the new file."""
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(path.name + ".partial")  # renamed over path once whole (Ctrl-C, a full disk)
-    try:
-        with open(partial, "wb") as handle:
-            np.savez_compressed(handle, fingerprint=np.array(fingerprint),
-                                **{key: np.asarray(poses[key]) for key in ("head_position", "head_attitude",
-                                                                          "control")})
-        partial.replace(path)
-    finally:
-        partial.unlink(missing_ok=True)
+    with files.replaced_atomically(path) as handle:  # whole or not at all (Ctrl-C, a full disk)
+        np.savez_compressed(handle, fingerprint=np.array(fingerprint),
+                            **{key: np.asarray(poses[key]) for key in ("head_position", "head_attitude", "control")})
     targets.clear_cache()
     return len(poses["head_position"])
 

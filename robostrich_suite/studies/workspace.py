@@ -22,6 +22,7 @@ import time
 import mujoco
 import numpy as np
 
+from robostrich_suite import files
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
@@ -251,8 +252,11 @@ def save_samples(path: str | pathlib.Path, kinematic: KinematicSamples,
         arrays.update({f"actuated_{f.name}": getattr(actuated, f.name)
                        for f in dataclasses.fields(actuated) if getattr(actuated, f.name) is not None})
         arrays["actuated_level"] = actuated.level()
-    np.savez_compressed(path, base_joint_xz=base_xz, reach_radius=reach_radius(),
-                        fingerprint=np.array(fingerprint_lib.model_fingerprint()), **arrays)
+    if path.suffix != ".npz":  # where np.savez would have put it
+        path = path.with_name(path.name + ".npz")
+    with files.replaced_atomically(path) as handle:
+        np.savez_compressed(handle, base_joint_xz=base_xz, reach_radius=reach_radius(),
+                            fingerprint=np.array(fingerprint_lib.model_fingerprint()), **arrays)
     return path
 
 

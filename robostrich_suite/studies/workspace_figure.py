@@ -5,6 +5,7 @@ import pathlib
 
 import numpy as np
 
+from robostrich_suite import files
 from robostrich_suite.studies import workspace
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
 
@@ -55,6 +56,6 @@ def plot_workspace(kinematic: workspace.KinematicSamples, actuated: workspace.Ac
                 handle.set_alpha(1)
     axes[0, 0].set_ylabel("z (m, up)")
     fig.tight_layout()
-    fig.savefig(path, dpi=130, bbox_inches="tight")  # the legends below the axes too
+    files.save_figure(fig, path, dpi=130, bbox_inches="tight")  # the legends below the axes too
     plt.close(fig)
     return path

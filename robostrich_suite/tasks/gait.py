@@ -43,6 +43,7 @@ import pathlib
 
 import numpy as np
 
+from robostrich_suite import files
 from robostrich_suite.model import quadruped as quad
 from robostrich_suite.model.legs import (MAX_TRUNK_HEIGHT, MIN_TRUNK_HEIGHT, SAG_COMPENSATION,  # noqa: F401
                                          assemble, check_trunk_height, foot_depth, leg_fk, leg_ik)
@@ -311,11 +312,4 @@ def write_gait_file(path, times, targets, comment: str | None = None) -> None:
     out.write(",".join(COLUMNS) + "\n")
     for t, row in zip(times, targets):
         out.write(",".join([f"{t:.6f}"] + [f"{v:.6f}" for v in row]) + "\n")
-    path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(path.name + ".partial")  # renamed over path once whole
-    try:
-        partial.write_text(out.getvalue())
-        partial.replace(path)
-    finally:
-        partial.unlink(missing_ok=True)
+    files.write_text(path, out.getvalue())

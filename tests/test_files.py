@@ -1,0 +1,34 @@
+"""Outputs are written whole or not at all: an error while writing leaves the old file as it was
+and no partial file beside it."""
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from robostrich_suite import files  # noqa: E402
+
+
+def test_an_error_mid_write_keeps_the_old_file_and_leaves_nothing_beside_it(tmp_path):
+    path = tmp_path / "targets.npz"
+    with files.replaced_atomically(path) as handle:
+        np.savez_compressed(handle, head_position=np.ones((3, 2)))
+    before = path.read_bytes()
+    with pytest.raises(RuntimeError, match="disk full"):
+        with files.replaced_atomically(path) as handle:
+            handle.write(b"half a file")
+            raise RuntimeError("disk full")
+    assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["targets.npz"]
+    np.testing.assert_array_equal(np.load(path)["head_position"], np.ones((3, 2)))
+
+
+def test_figures_and_text_land_whole_with_ordinary_permissions(tmp_path):
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [1, 0])
+    png = files.save_figure(fig, tmp_path / "sub" / "plot.png", dpi=50)
+    plt.close(fig)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and (png.stat().st_mode & 0o777) == 0o644
+    files.write_text(tmp_path / "table.md", "| a |\n")
+    assert (tmp_path / "table.md").read_text() == "| a |\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sub", "table.md"]
