@@ -9,13 +9,78 @@ import json
 import os
 import pickle
 import zlib
-from typing import Callable, List, Optional, Sequence, Tuple
+from typing import Callable, ClassVar, List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from agents import checkpoint
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
+
+
+@dataclasses.dataclass(frozen=True)
+class LessonSettings:
+    """What changes with the lesson while the agent carries over (Algorithm 1): lessons named by
+    their task get hindsight goals, a longer discount, or their own target entropy and correlated
+    exploration noise. Empty names: hindsight in every lesson, the rest in none."""
+    # Lessons whose batches get the config's her_ratio of hindsight goals (empty: every lesson).
+    her_lessons: Tuple[str, ...] = ()
+    # Lessons that train with `long_horizon_discount` instead of the config's discount, for
+    # manoeuvres that take longer than the discount looks ahead (0.99 at 125 Hz: 0.8 s).
+    long_horizon_lessons: Tuple[str, ...] = ()
+    long_horizon_discount: float = 0.995
+    # Lessons that train toward `exploration_target_entropy_per_action` x |A| instead of the
+    # config's target entropy: wider noise for a manoeuvre the policy's narrow noise never tries,
+    # or narrower noise where precision matters more than search ...
+    exploration_lessons: Tuple[str, ...] = ()
+    exploration_target_entropy_per_action: float = -1.0
+    # ... and explore there with noise correlated over control steps (AR(1) coefficient per step
+    # of the policy Gaussian's standard normal draw; 0 = white noise, as plain SAC).
+    exploration_noise_correlation: float = 0.0
+
+    LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons", "exploration_lessons")
+
+    def __post_init__(self):
+        for name in self.LESSON_LIST_FIELDS:
+            lessons = getattr(self, name)
+            if isinstance(lessons, str) or not all(isinstance(t, str) and t for t in lessons):
+                raise ValueError(f"{name} must be a tuple of task names, e.g. ('lesson1',), got {lessons!r}")
+            object.__setattr__(self, name, tuple(lessons))
+        if not 0.0 < self.long_horizon_discount <= 1.0:
+            raise ValueError(f"long_horizon_discount must be in (0, 1], got {self.long_horizon_discount}")
+        if not np.isfinite(self.exploration_target_entropy_per_action):
+            raise ValueError("exploration_target_entropy_per_action must be finite, "
+                             f"got {self.exploration_target_entropy_per_action}")
+        if not 0.0 <= self.exploration_noise_correlation < 1.0:
+            raise ValueError("exploration_noise_correlation must be in [0, 1) (0 = white noise), "
+                             f"got {self.exploration_noise_correlation}")
+
+    def her_ratio(self, task: str, config: SACConfig) -> float:
+        """The hindsight share of the batches while training on ``task``."""
+        return config.her_ratio if not self.her_lessons or task in self.her_lessons else 0.0
+
+    def discount(self, task: str, config: SACConfig) -> float:
+        return self.long_horizon_discount if task in self.long_horizon_lessons else config.discount
+
+    def target_entropy(self, task: str, config: SACConfig, action_size: int) -> float:
+        if task in self.exploration_lessons:
+            return self.exploration_target_entropy_per_action * float(action_size)
+        return config.resolved_target_entropy(action_size)
+
+    def noise_correlation(self, task: str) -> float:
+        """The exploration noise's correlation per control step while training on ``task``."""
+        return self.exploration_noise_correlation if task in self.exploration_lessons else 0.0
+
+    def to_dict(self) -> dict:
+        d = dataclasses.asdict(self)
+        return {k: list(v) if k in self.LESSON_LIST_FIELDS else v for k, v in d.items()}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "LessonSettings":
+        unknown = set(d) - {f.name for f in dataclasses.fields(cls)}
+        if unknown:
+            raise ValueError(f"unknown LessonSettings fields: {sorted(unknown)}")
+        return cls(**{k: tuple(v) if k in cls.LESSON_LIST_FIELDS else v for k, v in d.items()})
 
 
 @dataclasses.dataclass(frozen=True)
@@ -50,11 +115,13 @@ def format_plan(plan: Sequence[Lesson]) -> str:
     return ",".join(f"{l.domain}/{l.task}:{l.steps}" for l in plan)
 
 
-def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, extra: Optional[dict] = None) -> dict:
+def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, lessons: "LessonSettings" = None,
+                 extra: Optional[dict] = None) -> dict:
     """What makes two runs the same run: the part of a checkpoint's fingerprint known before building it
     (a resume is checked against it before anything is touched); ``extra``: what the environments
-    add (their options, say), in the fingerprint beside the config, the plan and the seed."""
-    return {"config": config.to_dict(), "plan": format_plan(plan), "seed": seed, **(extra or {})}
+    add (their options, say), beside the config, the lesson settings, the plan and the seed."""
+    return {"config": config.to_dict(), "lessons": (lessons or LessonSettings()).to_dict(),
+            "plan": format_plan(plan), "seed": seed, **(extra or {})}
 
 
 class TrainingInterrupted(RuntimeError):
@@ -67,13 +134,14 @@ def run_files(run_dir: str) -> Tuple[str, str, str]:
             os.path.join(run_dir, "evals.jsonl"))
 
 
-def check_lesson_names(plan, config: SACConfig, other_tasks: Sequence[str] = (), goal_tasks: bool = True) -> None:
+def check_lesson_names(plan, config: SACConfig, lessons: LessonSettings, other_tasks: Sequence[str] = (),
+                       goal_tasks: bool = True) -> None:
     """ValueError naming the field if a per-lesson setting names a task that is neither in ``plan``
     nor in ``other_tasks``: a misspelt lesson would silently turn its setting off. ``goal_tasks``:
     whether the plan's tasks have goals (``her_lessons`` is checked only then, as HER applies only there)."""
-    named = {"her_lessons": config.her_lessons if config.her_ratio > 0 and goal_tasks else (),
-             "long_horizon_lessons": config.long_horizon_lessons,
-             "exploration_lessons": config.exploration_lessons}
+    named = {"her_lessons": lessons.her_lessons if config.her_ratio > 0 and goal_tasks else (),
+             "long_horizon_lessons": lessons.long_horizon_lessons,
+             "exploration_lessons": lessons.exploration_lessons}
     known = {lesson.task for lesson in plan} | set(other_tasks)
     for field, lessons in named.items():
         unknown = sorted(set(lessons) - known)
@@ -95,24 +163,26 @@ class CurriculumRun:
 
     def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
                  make_environment: Callable, checkpoint_every: int = 10_000, name: str = "run",
-                 base_policy: Optional[Callable] = None, identity: Optional[dict] = None,
+                 lessons: Optional[LessonSettings] = None, residual=None, identity: Optional[dict] = None,
                  episode_probe: Optional[Callable] = None, keep_lesson_checkpoints: bool = False):
-        """``make_environment(lesson, seed)`` builds a lesson's environment; ``base_policy``, a
-        residual policy's base (see SACBuilder); ``identity``, what the fingerprint holds beside the
-        config, plan and seed (the environments' options); ``episode_probe(env)``, the metrics an
+        """``make_environment(lesson, seed)`` builds a lesson's environment; ``lessons``, what
+        changes with the lesson (default: nothing); ``residual``, a residual policy's (base policy
+        factory, scale) (SACBuilder); ``identity``, what the fingerprint holds beside the config,
+        lesson settings, plan and seed (the environments' options); ``episode_probe(env)``, the metrics an
         episode's record gets from its last state (SACBuilder.make_components).
         ``keep_lesson_checkpoints`` also writes a checkpoint at the end of every lesson but the
         last, ``after_lessonK.pkl`` (K lessons done): the policy of the first K lessons."""
         self.keep_lesson_checkpoints = bool(keep_lesson_checkpoints)
         self.plan = list(plan)
         self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
+        self.lessons = lessons or LessonSettings()
         self.identity = dict(identity or {})
         self.checkpoint_every = int(checkpoint_every)
         self.make_environment = make_environment
         self.lesson_index = 0
         self.lesson_steps = 0
         os.makedirs(run_dir, exist_ok=True)
-        self.loop = SACBuilder(config).make_components(self._make_lesson_env(0), seed, base_policy, episode_probe)
+        self.loop = SACBuilder(config).make_components(self._make_lesson_env(0), seed, residual, episode_probe)
         self._enter_lesson()
         self.checkpoint_path, self.metrics_path, self.evals_path = run_files(run_dir)
 
@@ -123,11 +193,11 @@ class CurriculumRun:
     def _enter_lesson(self):
         """What the loop changes with the lesson besides the environment: the hindsight share,
         the discount, the target entropy and the exploration noise's correlation."""
-        loop, task = self.loop, self.lesson.task
-        loop.her_ratio = self.config.her_ratio_in_lesson(task)
-        loop.learner.set_discount(self.config.discount_in_lesson(task))
-        loop.learner.set_target_entropy(self.config.target_entropy_in_lesson(task, loop.learner.networks.action_size))
-        loop.actor.noise_correlation = self.config.noise_correlation_in_lesson(task)
+        loop, task, lessons = self.loop, self.lesson.task, self.lessons
+        loop.her_ratio = lessons.her_ratio(task, self.config)
+        loop.learner.set_discount(lessons.discount(task, self.config))
+        loop.learner.set_target_entropy(lessons.target_entropy(task, self.config, loop.learner.networks.action_size))
+        loop.actor.noise_correlation = lessons.noise_correlation(task)
 
     def lesson_checkpoint_path(self, lessons_done: int) -> str:
         """Where ``keep_lesson_checkpoints`` writes the checkpoint after ``lessons_done`` lessons."""
@@ -150,7 +220,7 @@ class CurriculumRun:
 
     # -- checkpoints -----------------------------------------------------------------------
     def fingerprint(self) -> dict:
-        return {**run_identity(self.plan, self.config, self.seed, self.extra_identity()),
+        return {**run_identity(self.plan, self.config, self.seed, self.lessons, self.extra_identity()),
                 "observation_layout": self.loop.flattener.describe(),
                 "action_size": self.loop.actor.adapter.size}
 

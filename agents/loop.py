@@ -18,7 +18,7 @@ class EnvironmentLoop:
     """Generic over the learner: anything with `step(batches) -> metrics` and `policy_params`; `config` gives
     the loop's schedule (action_repeat, min_replay_size, env_steps_per_call, updates_per_call, batch_size,
     her_ratio, relabel_rewards), e.g. an agents.sac.SACConfig. ``her_ratio`` starts at the config's; a
-    curriculum sets it per lesson (SACConfig.her_lessons)."""
+    curriculum sets it per lesson (curriculum.LessonSettings.her_lessons)."""
 
     def __init__(self, env, actor: Actor, replay: ReplayBuffer, learner, config,
                  flattener: ObservationFlattener, seed: int = 0, label: str = "",

@@ -205,8 +205,9 @@ def test_correlated_exploration_noise_follows_an_ar1_process_with_the_policys_sp
         spread[rho] = float(eps.std())
     assert abs(lag1[0.0]) < 0.1 and 0.9 < lag1[0.95] < 0.99, lag1
     assert 0.8 < spread[0.0] < 1.2 and 0.6 < spread[0.95] < 1.4, spread
+    from agents.curriculum import LessonSettings
     with pytest.raises(ValueError, match="exploration_noise_correlation must be in"):
-        SACConfig(exploration_noise_correlation=1.0)
+        LessonSettings(exploration_noise_correlation=1.0)
 
 
 def test_action_anchor_keeps_the_deterministic_action_near_zero():

@@ -5,7 +5,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from agents.curriculum import TrainingInterrupted
+from agents.curriculum import LessonSettings, TrainingInterrupted
 from agents.robostrich.runs import DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
@@ -100,8 +100,8 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
     """her_lessons=("lesson1",): lesson 1's batches get hindsight goals, lesson 2's keep the real
     targets, and a run resumed in lesson 2 keeps HER off."""
     plan = parse_plan("robostrich/lesson1:600,robostrich/lesson2:600")
-    config = dataclasses.replace(HER, her_lessons=("lesson1",))
-    run = DomainRun(plan, config, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
+    config, lessons = HER, LessonSettings(her_lessons=("lesson1",))
+    run = DomainRun(plan, config, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000, lessons=lessons)
     assert run.loop.her_ratio == 0.5
     with pytest.raises(TrainingInterrupted):
         run.run(stop_at_step=800)
@@ -114,21 +114,21 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
         return np.mean([tuple(g) not in real_targets for g in goals])
 
     assert relabelled_share(run.loop.her_ratio) == 0.0
-    assert relabelled_share(config.her_ratio_in_lesson("lesson1")) > 0.3  # what lesson 1 sampled
+    assert relabelled_share(lessons.her_ratio("lesson1", config)) > 0.3  # what lesson 1 sampled
     path = str(tmp_path / "ckpt.pkl")
     run.save_checkpoint(path)
-    resumed = DomainRun(plan, config, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
+    resumed = DomainRun(plan, config, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000, lessons=lessons)
     assert resumed.loop.her_ratio == 0.5  # lesson 1 until the checkpoint says otherwise
     resumed.restore(path)
     assert resumed.loop.her_ratio == 0.0
     with pytest.raises(ValueError, match="her_lessons"):
-        SACConfig(her_ratio=0.5, her_lessons="lesson1")  # a string, not a tuple of names
-    off = DomainRun(plan, dataclasses.replace(HER, her_ratio=0.0, her_lessons=("lesson_1",)), seed=1,
-                        run_dir=str(tmp_path / "off"))  # --her-ratio 0 turns HER off whatever the lessons say
+        LessonSettings(her_lessons="lesson1")  # a string, not a tuple of names
+    misspelt = LessonSettings(her_lessons=("lesson_1",))
+    off = DomainRun(plan, dataclasses.replace(HER, her_ratio=0.0), seed=1, run_dir=str(tmp_path / "off"),
+                    lessons=misspelt)  # --her-ratio 0 turns HER off whatever the lessons say
     assert off.loop.her_ratio == 0.0
     with pytest.raises(ValueError, match=r"her_lessons names \['lesson_1'\]"):
-        DomainRun(plan, dataclasses.replace(HER, her_lessons=("lesson_1",)), seed=1,
-                      run_dir=str(tmp_path / "c"))
+        DomainRun(plan, HER, seed=1, run_dir=str(tmp_path / "c"), lessons=misspelt)
 
 
 def test_level_goals_only_relabel_with_poses_the_lesson_could_set(run):

@@ -166,8 +166,9 @@ def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
 
 def test_incomplete_checkpoints_and_task_names_are_refused_before_any_work(tmp_path):
     from agents.sac.config import SACConfig
+    from agents.curriculum import LessonSettings
     fingerprint = {"plan": "robostrich/lesson1:300,robostrich/lesson2:300", "config": SACConfig().to_dict(),
-                   "seed": 0, "observation_layout": [], "action_size": 9}
+                   "lessons": LessonSettings().to_dict(), "seed": 0, "observation_layout": [], "action_size": 9}
     empty, whole = tmp_path / "empty.pkl", tmp_path / "whole.pkl"
     checkpoint.save(str(empty), {}, fingerprint)
     checkpoint.save(str(whole), {k: None for k in ("learner", "actor_key", "actor_noise", "replay", "loop",

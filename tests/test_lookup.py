@@ -117,7 +117,7 @@ def test_evaluation_judges_success_with_the_tasks_own_tolerances():
     assert not results[1e-4]["success"] and results[1e-4]["tolerances"][0] == 1e-4
 
 
-def test_residual_adapter_offsets_the_lookup_by_a_bounded_correction(flattener):
+def test_residual_adapter_offsets_the_lookup_by_a_bounded_correction(flattener, tmp_path):
     from agents.actors import ResidualAdapter
     env = make_environment("robostrich", "lesson2", 0)
     spec = env.action_spec()
@@ -134,14 +134,15 @@ def test_residual_adapter_offsets_the_lookup_by_a_bounded_correction(flattener):
     with pytest.raises(ValueError, match="residual scale"):
         ResidualAdapter(spec, lookup, scale=0.0)
     with pytest.raises(ValueError, match="do not mix"):
-        SACConfig(residual_scale=0.25, her_ratio=0.5)
+        DomainRun(parse_plan("lesson2:100"), SACConfig(her_ratio=0.5), seed=0, run_dir=str(tmp_path / "mix"),
+                  residual_scale=0.25)
 
 
 def test_untrained_residual_agent_is_the_lookup(flattener, tmp_path):
     """The policy's mean head starts at zero, so before any update the residual agent's
     deterministic action is the lookup's and it lands where the lookup lands."""
-    config = SACConfig(residual_scale=0.25, min_replay_size=10, her_ratio=0.0)
-    run = DomainRun(parse_plan("lesson2:100"), config, seed=0, run_dir=str(tmp_path / "run"))
+    config = SACConfig(min_replay_size=10, her_ratio=0.0)
+    run = DomainRun(parse_plan("lesson2:100"), config, seed=0, run_dir=str(tmp_path / "run"), residual_scale=0.25)
     actor = SACBuilder.make_eval_actor(run.loop)
     target = targets.heldout_targets()[:2]
     agent = evaluation.evaluate_heldout(actor, run.loop.flattener, "robostrich", "lesson2", targets=target)

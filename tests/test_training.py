@@ -1,4 +1,5 @@
 """Checkpoints, resumption and the curriculum, on dm_control's point_mass (real MuJoCo, tiny networks)."""
+import dataclasses
 import json
 import os
 
@@ -8,7 +9,7 @@ import pytest
 
 from agents import checkpoint
 from agents.robostrich import training
-from agents.curriculum import TrainingInterrupted
+from agents.curriculum import LessonSettings, TrainingInterrupted
 from agents.robostrich.runs import DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
@@ -119,9 +120,9 @@ def test_checkpoint_of_another_format_version_or_missing_a_field_is_refused_in_o
     assert "format version 1" in message and f"reads version {checkpoint.FORMAT_VERSION}" in message
     assert "\n" not in message and checkpoint.FORMAT_VERSION == 2
     lacking = run.fingerprint()
-    lacking["config"] = {k: v for k, v in lacking["config"].items() if k != "her_lessons"}
+    lacking["config"] = {k: v for k, v in lacking["config"].items() if k != "her_ratio"}
     checkpoint.save(str(tmp_path / "lacking.pkl"), payload, lacking)
-    with pytest.raises(ValueError, match=r"her_lessons: checkpoint has '<missing>'"):
+    with pytest.raises(ValueError, match=r"her_ratio: checkpoint has '<missing>'"):
         DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "c")).restore(str(tmp_path / "lacking.pkl"))
     DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "d")).restore(run.checkpoint_path)  # its own: fine
 
@@ -188,12 +189,15 @@ def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
     assert not config.critic_layer_norm and config.her_ratio == 0 and config.init_temperature == 1.0
     default = training.config_from_args(training.build_parser().parse_args(["--domain", "reacher"]), [])
     assert default == SACConfig()  # the CLI's defaults are the dataclass's, under the main job's on robostrich
-    arm = training.config_from_args(training.build_parser().parse_args([]), [])
-    assert arm == SACConfig(**training.MAIN_JOB_CONFIG["robostrich"])
+    arm = training.config_from_args(training.build_parser().parse_args([]), [], LessonSettings)
+    assert arm == dataclasses.replace(training.TRAINING_LESSONS, **training.MAIN_JOB_CONFIG["robostrich"])
+    paper = training.config_from_args(args, ["--paper-sac", "--batch-size", "32"], LessonSettings)
+    assert paper == LessonSettings()  # nothing per lesson
     argv = ["--her-ratio", "0.5", "--her-lessons", "lesson1,lesson2", "--hidden-sizes", "32,16"]
-    config = training.config_from_args(training.build_parser().parse_args(argv), argv)
-    assert config.her_lessons == ("lesson1", "lesson2") and config.hidden_sizes == (32, 16)
-    assert (config.her_ratio_in_lesson("lesson2"), config.her_ratio_in_lesson("lesson3")) == (0.5, 0.0)
+    args = training.build_parser().parse_args(argv)
+    config, lessons = training.config_from_args(args, argv), training.config_from_args(args, argv, LessonSettings)
+    assert lessons.her_lessons == ("lesson1", "lesson2") and config.hidden_sizes == (32, 16)
+    assert (lessons.her_ratio("lesson2", config), lessons.her_ratio("lesson3", config)) == (0.5, 0.0)
 
 
 def test_lesson_checkpoints_hold_the_policy_after_each_lesson(tmp_path):
@@ -225,7 +229,8 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     config = SACConfig()
     assert config.resolved_target_entropy(9) == -18.0 and SACConfig.paper_sac().resolved_target_entropy(9) == -9.0
     assert SACConfig(target_entropy=-3.0).resolved_target_entropy(9) == -3.0  # an explicit value wins
-    assert [config.her_ratio_in_lesson(t) for t in ("lesson1", "lesson2", "lesson3", "lesson4")] == [0.5, 0.0, 0.0, 0.0]
+    assert [training.TRAINING_LESSONS.her_ratio(t, config) for t in ("lesson1", "lesson2", "lesson3", "lesson4")] == [
+        0.5, 0.0, 0.0, 0.0]
     assert not config.her_level_goals and not SACConfig.paper_sac().her_level_goals
     assert training.resolve_layout(None, arm) == "ventral_slips" == arm.layout  # the tasks' own, by name
     assert training.resolve_layout("antagonist_pairs", arm) == "antagonist_pairs"
@@ -253,19 +258,21 @@ def test_main_job_on_the_arm_gives_lesson_3_the_longest_share_and_narrower_noise
     target entropy at -3 per tendon; a flag given wins, --paper-sac and other domains keep theirs."""
     def made(*argv):
         args = training.build_parser().parse_args(list(argv))
-        return training.format_plan(training.plan_from_args(args)), training.config_from_args(args, list(argv))
+        return (training.format_plan(training.plan_from_args(args)), training.config_from_args(args, list(argv)),
+                training.config_from_args(args, list(argv), LessonSettings))
 
-    plan, config = made()
+    plan, config, lessons = made()
     assert plan == "robostrich/lesson1:160000,robostrich/lesson2:160000,robostrich/lesson3:280000"
-    assert config.target_entropy_in_lesson("lesson3", 9) == -27.0
-    assert config.target_entropy_in_lesson("lesson1", 9) == config.target_entropy_in_lesson("lesson2", 9) == -18.0
+    assert lessons.target_entropy("lesson3", config, 9) == -27.0
+    assert lessons.target_entropy("lesson1", config, 9) == lessons.target_entropy("lesson2", config, 9) == -18.0
     assert made("--steps", "1500")[0] == "robostrich/lesson1:400,robostrich/lesson2:400,robostrich/lesson3:700"
     assert made("--lessons", "lesson1,lesson3", "--steps", "1000")[0] == "robostrich/lesson1:500,robostrich/lesson3:500"
-    assert made("--exploration-target-entropy-per-action", "-2.5")[1].target_entropy_in_lesson("lesson3", 9) == -22.5
-    assert made("--exploration-lessons", "")[1].exploration_lessons == ()
-    assert made("--paper-sac")[1].exploration_lessons == ()
-    plan, config = made("--domain", "robostrich_a1")
-    assert plan.count(":120000") == 4 and config.exploration_lessons == ()
+    _, config, lessons = made("--exploration-target-entropy-per-action", "-2.5")
+    assert lessons.target_entropy("lesson3", config, 9) == -22.5
+    assert made("--exploration-lessons", "")[2].exploration_lessons == ()
+    assert made("--paper-sac")[2].exploration_lessons == ()
+    plan, config, lessons = made("--domain", "robostrich_a1")
+    assert plan.count(":120000") == 4 and lessons.exploration_lessons == ()
 
 
 def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resume(tmp_path):
@@ -274,9 +281,9 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
     a run resumed inside the lesson keeps its discount; a misspelt lesson is an error."""
     import dataclasses
     plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
-    long = dataclasses.replace(TINY, long_horizon_lessons=("hard",), long_horizon_discount=0.9)
+    long = LessonSettings(long_horizon_lessons=("hard",), long_horizon_discount=0.9)
     plain = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
-    other = DomainRun(plan, long, seed=0, run_dir=str(tmp_path / "long"), checkpoint_every=600)
+    other = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "long"), checkpoint_every=600, lessons=long)
     assert other.loop.learner.config.discount == 0.99
     for run in (plain, other):
         with pytest.raises(TrainingInterrupted):
@@ -286,7 +293,7 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
     plain.run()
     with pytest.raises(TrainingInterrupted):
         other.run(stop_at_step=600)
-    resumed = DomainRun(plan, long, seed=0, run_dir=str(tmp_path / "long"))
+    resumed = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "long"), lessons=long)
     resumed.restore()
     assert resumed.loop.learner.config.discount == 0.9
     other.run()
@@ -296,10 +303,9 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
                                                         leaves(other.loop.learner.state.q_params))]
     assert all(differs)
     with pytest.raises(ValueError, match=r"long_horizon_lessons names \['lesson3'\]"):
-        DomainRun(plan, dataclasses.replace(TINY, long_horizon_lessons=("lesson3",)), seed=0,
-                      run_dir=str(tmp_path / "bad"))
+        DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "bad"), lessons=LessonSettings(long_horizon_lessons=("lesson3",)))
     with pytest.raises(ValueError, match="long_horizon_discount must be in"):
-        dataclasses.replace(TINY, long_horizon_discount=1.5)
+        LessonSettings(long_horizon_discount=1.5)
 
 
 def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_resume(tmp_path):
@@ -310,10 +316,10 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     to the end), and a misspelt lesson or a NaN target is an error."""
     import dataclasses
     plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
-    explore = dataclasses.replace(TINY, exploration_lessons=("hard",), exploration_target_entropy_per_action=1.0,
-                                  exploration_noise_correlation=0.9)
+    explore = LessonSettings(exploration_lessons=("hard",), exploration_target_entropy_per_action=1.0,
+                             exploration_noise_correlation=0.9)
     plain = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
-    other = DomainRun(plan, explore, seed=0, run_dir=str(tmp_path / "explore"), checkpoint_every=600)
+    other = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "explore"), checkpoint_every=600, lessons=explore)
     actions = other.loop.learner.networks.action_size
     assert other.loop.learner.config.resolved_target_entropy(actions) == -2.0 * actions
     for run in (plain, other):
@@ -325,7 +331,7 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     plain.run()
     with pytest.raises(TrainingInterrupted):
         other.run(stop_at_step=600)
-    resumed = DomainRun(plan, explore, seed=0, run_dir=str(tmp_path / "explore"))
+    resumed = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "explore"), lessons=explore)
     resumed.restore()
     assert resumed.loop.learner.config.resolved_target_entropy(actions) == 1.0 * actions
     assert resumed.loop.actor.noise_correlation == 0.9 and plain.loop.actor.noise_correlation == 0.0
@@ -339,7 +345,6 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     # Over the second lesson the plain run's temperature keeps falling, the explorer's turns up.
     assert temperature["explore"] > at_switch > temperature["plain"], (at_switch, temperature)
     with pytest.raises(ValueError, match=r"exploration_lessons names \['lesson3'\]"):
-        DomainRun(plan, dataclasses.replace(TINY, exploration_lessons=("lesson3",)), seed=0,
-                      run_dir=str(tmp_path / "bad"))
+        DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "bad"), lessons=LessonSettings(exploration_lessons=("lesson3",)))
     with pytest.raises(ValueError, match="exploration_target_entropy_per_action must be finite"):
-        dataclasses.replace(TINY, exploration_target_entropy_per_action=float("nan"))
+        LessonSettings(exploration_target_entropy_per_action=float("nan"))

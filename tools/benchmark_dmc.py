@@ -184,7 +184,7 @@ def main(argv=None) -> int:
                                 critic_layer_norm=args.critic_layer_norm, init_temperature=args.init_temperature,
                                 target_entropy_per_action=args.target_entropy_per_action,
                                 pre_tanh_penalty=args.pre_tanh_penalty,
-                                her_ratio=0.0, her_lessons=()) for t in tasks}
+                                her_ratio=0.0) for t in tasks}
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

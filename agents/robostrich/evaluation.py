@@ -304,7 +304,7 @@ def checked_fingerprint(path: str) -> dict:
     from agents.robostrich.runs import DomainRun
     record, _ = checkpoint.read_with_digest(path)
     fp = record["fingerprint"]
-    missing = ([k for k in ("plan", "config", "seed") if k not in fp]
+    missing = ([k for k in ("plan", "config", "lessons", "seed") if k not in fp]
                + [k for k in DomainRun.STATE_FIELDS if k not in record["payload"]])
     if missing:
         raise checkpoint.CheckpointError(f"{path} is not a whole robostrich-train checkpoint: it lacks {missing}")
@@ -319,13 +319,15 @@ def checkpoint_domain(fingerprint: dict):
 
 def load_run_from_checkpoint(path: str):
     """Rebuild the DomainRun that wrote `path` (its fingerprint holds config, plan and seed)."""
+    from agents.curriculum import LessonSettings
     from agents.robostrich.runs import DomainRun, parse_plan
     from agents.sac.config import SACConfig
     fp = checked_fingerprint(path)
     scratch = tempfile.mkdtemp(prefix="robostrich-evaluate-")  # the run's own files are left untouched
     try:
         run = DomainRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch,
-                        task_kwargs=fp.get("task_kwargs"), layout=fp.get("layout"), init_from=fp.get("init_from"))
+                        task_kwargs=fp.get("task_kwargs"), layout=fp.get("layout"), init_from=fp.get("init_from"),
+                        lessons=LessonSettings.from_dict(fp["lessons"]), residual_scale=fp.get("residual_scale", 0.0))
         run.restore(path)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)

@@ -4,12 +4,14 @@ episode's record."""
 from typing import Callable, Optional, Sequence
 
 from agents import curriculum
-from agents.curriculum import Lesson
+from agents.curriculum import Lesson, LessonSettings
 from agents.robostrich import probes
 from agents.robostrich.domains import as_domain
 from agents.sac.config import SACConfig
 
 DEFAULT_DOMAIN = "robostrich"
+# What changes with the lesson unless a run says otherwise: hindsight goals in lesson 1 only.
+DEFAULT_LESSONS = LessonSettings(her_lessons=("lesson1",))
 
 
 def parse_plan(text: str, default_domain: str = DEFAULT_DOMAIN):
@@ -36,10 +38,13 @@ def named_layout(layout: Optional[str], plan) -> Optional[str]:
 
 
 def identity_extra(plan, task_kwargs: Optional[dict] = None, layout: Optional[str] = None,
-                   init_from: Optional[str] = None) -> dict:
-    """What a run's fingerprint holds beside config, plan and seed: the task options, the layout
-    by name and ``init_from``, the content hash of the checkpoint the run started from (agents/robostrich/transfer.py)."""
+                   init_from: Optional[str] = None, residual_scale: float = 0.0) -> dict:
+    """What a run's fingerprint holds beside config, lesson settings, plan and seed: the task options,
+    the layout by name, ``init_from`` (the content hash of the checkpoint the run started from,
+    agents/robostrich/transfer.py) and a residual policy's scale."""
     extra = {}
+    if residual_scale:
+        extra["residual_scale"] = float(residual_scale)
     if task_kwargs:
         extra["task_kwargs"] = dict(task_kwargs)
     layout = named_layout(layout, plan)
@@ -50,18 +55,20 @@ def identity_extra(plan, task_kwargs: Optional[dict] = None, layout: Optional[st
     return extra
 
 
-def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, task_kwargs: Optional[dict] = None,
-                 layout: Optional[str] = None, init_from: Optional[str] = None) -> dict:
+def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, lessons: LessonSettings = DEFAULT_LESSONS,
+                 task_kwargs: Optional[dict] = None, layout: Optional[str] = None, init_from: Optional[str] = None,
+                 residual_scale: float = 0.0) -> dict:
     """The fingerprint part known before a run is built (robostrich-train checks a resume against it)."""
-    return curriculum.run_identity(plan, config, seed, identity_extra(plan, task_kwargs, layout, init_from))
+    return curriculum.run_identity(plan, config, seed, lessons,
+                                   identity_extra(plan, task_kwargs, layout, init_from, residual_scale))
 
 
-def check_lesson_names(plan, config: SACConfig, layout: Optional[str] = None) -> None:
+def check_lesson_names(plan, config: SACConfig, lessons: LessonSettings, layout: Optional[str] = None) -> None:
     """ValueError naming the field if a per-lesson setting names a task the plan's domains lack (dm_control's
     tasks have no goal reward, so HER's lessons are checked on the arm only). An unknown `layout`, or
     one on a dm_control plan, fails here too."""
     arm_domains = {d for d in (as_domain(lesson.domain, layout) for lesson in plan) if d.is_arm}
-    curriculum.check_lesson_names(plan, config, [t for d in arm_domains for t in d.tasks()], bool(arm_domains))
+    curriculum.check_lesson_names(plan, config, lessons, [t for d in arm_domains for t in d.tasks()], bool(arm_domains))
 
 
 class DomainRun(curriculum.CurriculumRun):
@@ -70,33 +77,36 @@ class DomainRun(curriculum.CurriculumRun):
     def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
                  checkpoint_every: int = 10_000, env_factory: Callable = make_environment, name: str = "run",
                  task_kwargs: Optional[dict] = None, layout: Optional[str] = None,
-                 init_from: Optional[str] = None, keep_lesson_checkpoints: bool = False):
+                 init_from: Optional[str] = None, keep_lesson_checkpoints: bool = False,
+                 lessons: LessonSettings = DEFAULT_LESSONS, residual_scale: float = 0.0):
         """``task_kwargs`` go to every lesson's task (e.g. eq. 10's ``weights``); ``layout`` names a
         built-in tendon layout of the arm domains (its own targets come with it); ``init_from`` is the
         content hash of the checkpoint whose learner this run starts from (transfer.initialize puts
-        it there); ``env_factory(domain, task, seed, **task_kwargs)`` builds a lesson's environment."""
-        check_lesson_names(plan, config, layout)  # and an unknown layout fails here, not mid-run
+        it there); ``env_factory(domain, task, seed, **task_kwargs)`` builds a lesson's environment;
+        ``residual_scale`` > 0 trains a residual on the first lesson's lookup."""
+        check_lesson_names(plan, config, lessons, layout)  # and an unknown layout fails here, not mid-run
         self.task_kwargs = dict(task_kwargs or {})
         self.layout = layout
         self.init_from = init_from
         self.env_factory = env_factory
+        self.residual_scale = float(residual_scale)
         super().__init__(plan, config, seed, run_dir, self._make_lesson_environment, checkpoint_every, name,
-                         base_policy=self._base_policy(plan, config), episode_probe=probes.episode_metrics, keep_lesson_checkpoints=keep_lesson_checkpoints)
+                         lessons=lessons, residual=self._residual(plan), episode_probe=probes.episode_metrics, keep_lesson_checkpoints=keep_lesson_checkpoints)
 
     def extra_identity(self) -> dict:
         """The task options, the layout and ``init_from`` (which transfer.initialize may set after building)."""
-        return identity_extra(self.plan, self.task_kwargs, self.layout, self.init_from)
+        return identity_extra(self.plan, self.task_kwargs, self.layout, self.init_from, self.residual_scale)
 
     def _make_lesson_environment(self, lesson: Lesson, seed: int):
         return self.env_factory(self.domain(lesson), lesson.task, seed, **self.task_kwargs)
 
-    def _base_policy(self, plan, config: SACConfig):
-        """The residual's base: the lookup of the first lesson's domain and layout."""
-        if config.residual_scale <= 0:
+    def _residual(self, plan):
+        """(base policy factory, scale) of a residual on the first lesson's lookup, or None."""
+        if self.residual_scale <= 0:
             return None
         from agents.robostrich.lookup import LookupPolicy
         table = self.domain(plan[0]).lookup_table()
-        return lambda flattener: LookupPolicy(flattener, table)
+        return (lambda flattener: LookupPolicy(flattener, table)), self.residual_scale
 
     def domain(self, lesson: Optional[Lesson] = None):
         """The Domain of `lesson` (default: the last), with this run's layout."""

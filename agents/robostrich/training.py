@@ -25,7 +25,7 @@ from typing import Optional
 import numpy as np
 
 from agents.robostrich import evaluation
-from agents.curriculum import Lesson, format_plan, read_records, run_files
+from agents.curriculum import Lesson, LessonSettings, format_plan, read_records, run_files
 from agents.robostrich.runs import DomainRun, check_lesson_names, parse_plan, run_identity
 from agents.robostrich.domains import Domain
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
@@ -43,7 +43,10 @@ DEFAULT_TOTAL_STEPS = 480_000  # per run, split evenly over the lessons; the two
 MAIN_JOB_STEPS = {"robostrich": 600_000}
 MAIN_JOB_LESSON_SHARES = {"robostrich": (4, 4, 7)}  # of the domain's curriculum, in order
 MAIN_JOB_CONFIG = {"robostrich": {"exploration_lessons": ("lesson3",),
-                                  "exploration_target_entropy_per_action": -3.0}}
+                                  "exploration_target_entropy_per_action": -3.0}}  # LessonSettings fields
+# What changes with the lesson on every domain: hindsight goals in lesson 1 only (without them
+# some seeds never learn the upper workspace; in lessons 2-3 they hurt: docs/learning.md).
+TRAINING_LESSONS = LessonSettings(her_lessons=("lesson1",))
 MAX_TOTAL_STEPS = 100_000_000  # per run: about three days on 2 CPU cores
 # On the arm domains the main job trains the tasks' own routing, the reconstruction of the paper's
 # Fig. 1B (robostrich_suite.model.layouts.DEFAULT); `--layout antagonist_pairs` trains the best
@@ -100,6 +103,16 @@ def check_task_kwargs(plan, layout, task_kwargs: dict) -> None:
             raise ValueError(f"--task-kwargs {json.dumps(task_kwargs, default=str)} does not suit "
                              f"{domain_name}/{task}: {error}") from error
         env.close()
+
+
+def check_residual_scale(scale: float, config: SACConfig) -> float:
+    """--residual-scale in [0, 2] and not with hindsight goals (a new goal changes the lookup's action)."""
+    if not 0.0 <= scale <= 2.0:
+        raise ValueError(f"--residual-scale must be in [0, 2] (0 = no residual), got {scale}")
+    if scale > 0 and config.her_ratio > 0:
+        raise ValueError("--residual-scale and --her-ratio do not mix: a relabelled goal changes the lookup's "
+                         "action, so the stored residual would no longer mean what it did (add --her-ratio 0)")
+    return float(scale)
 
 
 def check_action_change(task_kwargs: dict, config: SACConfig) -> None:
@@ -224,8 +237,21 @@ def build_parser():
                    help="runs trained at once, one process each (default: %(default)s; the curriculum and "
                         "the plain-SAC baseline are independent)")
     p.add_argument("--stop-at-step", type=positive_int, default=None, help=argparse.SUPPRESS)  # imitates a kill (tests)
-    add_config_arguments(p.add_argument_group("SAC (defaults: agents/sac/config.py)"))
+    add_agent_arguments(p)
     return p
+
+
+def add_agent_arguments(p) -> None:
+    """The agent's settings (SACConfig), what changes per lesson (LessonSettings), the residual and --paper-sac."""
+    add_config_arguments(p.add_argument_group("SAC (defaults: agents/sac/config.py)"), SACConfig())
+    lessons = p.add_argument_group("per lesson (agents/curriculum.py LessonSettings; defaults: TRAINING_LESSONS)")
+    add_config_arguments(lessons, TRAINING_LESSONS)
+    lessons.add_argument("--residual-scale", type=float, default=0.0,
+                         help="train a residual on the lookup's stored inputs, within this fraction of each "
+                              "tendon's half-range (0, the default: the policy gives the whole input)")
+    p.add_argument("--paper-sac", action="store_true",
+                   help="the paper's plain SAC (Acme defaults, no agent improvements, nothing per lesson); "
+                        "flags given explicitly still apply on top")
 
 
 def _config_flags(field_name: str) -> tuple:
@@ -237,10 +263,10 @@ def _shown(value) -> str:
     return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
 
 
-def add_config_arguments(group, defaults: SACConfig = SACConfig()):
-    """One flag per SACConfig field (``--field-name``), its default read from the dataclass: the
-    dataclass is the one home of the training defaults, the CLI only exposes them."""
-    for field in dataclasses.fields(SACConfig):
+def add_config_arguments(group, defaults):
+    """One flag per field of ``defaults``' dataclass (``--field-name``), its default read from it:
+    the dataclass is the one home of the training defaults, the CLI only exposes them."""
+    for field in dataclasses.fields(defaults):
         default = getattr(defaults, field.name)
         flags = _config_flags(field.name)
         help_text = f"(default: {_shown(default)}"
@@ -256,46 +282,45 @@ def add_config_arguments(group, defaults: SACConfig = SACConfig()):
             group.add_argument(*flags, dest=field.name, type=float, default=None, help=help_text)
         else:
             group.add_argument(*flags, dest=field.name, type=type(default), default=default, help=help_text)
-    group.add_argument("--paper-sac", action="store_true",
-                       help="the paper's plain SAC (Acme defaults, no agent improvements); "
-                            "flags given explicitly still apply on top")
 
 
-def config_from_args(args, argv=None) -> SACConfig:
-    values = {f.name: getattr(args, f.name) for f in dataclasses.fields(SACConfig)}
-    hints = typing.get_type_hints(SACConfig)
-    for field in dataclasses.fields(SACConfig):  # tuple fields come as "64,64" or "lesson1,lesson2"
+def config_from_args(args, argv=None, cls=SACConfig):
+    """The ``cls`` (SACConfig or LessonSettings) the flags give: under --paper-sac the paper's
+    (nothing per lesson), else the main job's settings on its domain, explicit flags on top."""
+    values = {f.name: getattr(args, f.name) for f in dataclasses.fields(cls)}
+    hints = typing.get_type_hints(cls)
+    for field in dataclasses.fields(cls):  # tuple fields come as "64,64" or "lesson1,lesson2"
         if isinstance(field.default, tuple):
             item_type = typing.get_args(hints[field.name])[0]
             values[field.name] = tuple(item_type(item.strip()) for item in str(values[field.name]).split(",")
                                        if item.strip())
+    explicit = _explicit_fields(argv, cls)
     if getattr(args, "paper_sac", False):
-        explicit = _explicit_fields(argv)
-        paper = SACConfig.paper_sac()
+        paper = SACConfig.paper_sac() if cls is SACConfig else LessonSettings()
         values = {k: (v if k in explicit else getattr(paper, k)) for k, v in values.items()}
     else:  # the main job's settings on its domain, under the flags given
-        explicit = _explicit_fields(argv)
         values.update({k: v for k, v in MAIN_JOB_CONFIG.get(getattr(args, "domain", None), {}).items()
-                       if k not in explicit})
+                       if k not in explicit and k in values})
     try:
-        return SACConfig(**values)
+        return cls(**values)
     except ValueError as error:  # SACConfig names its fields; the user typed flags
         raise ValueError(_with_flags(str(error))) from None
 
 
 def _with_flags(message: str) -> str:
-    """``message`` with every SACConfig field name replaced by its flag(s), e.g. learning_rate -> --learning-rate."""
+    """``message`` with every config field name replaced by its flag(s), e.g. learning_rate -> --learning-rate."""
     import re
-    flags = {f.name: "/".join(_config_flags(f.name)) for f in dataclasses.fields(SACConfig)}
+    flags = {f.name: "/".join(_config_flags(f.name))
+             for cls in (SACConfig, LessonSettings) for f in dataclasses.fields(cls)}
     return re.sub(r"\b(" + "|".join(sorted(flags, key=len, reverse=True)) + r")\b",
                   lambda m: flags[m.group(1)], message)
 
 
-def _explicit_fields(argv) -> set:
-    """Config fields named on the command line (so --paper-sac does not override them)."""
+def _explicit_fields(argv, cls=SACConfig) -> set:
+    """Fields of ``cls`` named on the command line (so --paper-sac does not override them)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     named = set()
-    for field in dataclasses.fields(SACConfig):
+    for field in dataclasses.fields(cls):
         flags = _config_flags(field.name)
         for token in argv:
             option = token.split("=", 1)[0]
@@ -392,6 +417,8 @@ class RunSpec:
     checkpoint_every: int
     task_kwargs: Optional[dict]
     layout: Optional[str]
+    lessons: LessonSettings = TRAINING_LESSONS
+    residual_scale: float = 0.0
     init_from: Optional[str] = None  # a checkpoint to start a fresh run's learner from (agents/robostrich/transfer.py)
     init_digest: Optional[str] = None  # its content hash, kept in the run's fingerprint
     keep_lesson_checkpoints: bool = False  # also a checkpoint after every lesson but the last
@@ -405,8 +432,9 @@ class RunSpec:
         damaged or mismatched checkpoint, never restarts silently)."""
         run = DomainRun(list(self.plan), self.config, self.seed, self.run_dir,
                             checkpoint_every=self.checkpoint_every, name=self.label,
-                            task_kwargs=self.task_kwargs, layout=self.layout, init_from=self.init_digest,
-                            keep_lesson_checkpoints=self.keep_lesson_checkpoints)
+                        task_kwargs=self.task_kwargs, layout=self.layout, init_from=self.init_digest,
+                        keep_lesson_checkpoints=self.keep_lesson_checkpoints, lessons=self.lessons,
+                        residual_scale=self.residual_scale)
         if restore and os.path.exists(run.checkpoint_path):
             run.restore()
         elif self.init_from is not None:
@@ -594,6 +622,8 @@ def main(argv=None):
 class _Setup:
     """What the command line resolves to before anything is built."""
     config: SACConfig
+    lessons: LessonSettings
+    residual_scale: float
     plan: list
     domain: Domain
     heldout_task: str
@@ -604,6 +634,8 @@ class _Setup:
 def prepare(args, argv) -> _Setup:
     """Config, plan, domain, layout and task options from ``args``, every name and value checked."""
     config = config_from_args(args, argv)
+    lessons = config_from_args(args, argv, LessonSettings)
+    residual_scale = check_residual_scale(args.residual_scale, config)
     plan = plan_from_args(args)
     final = plan[-1]
     final_domain = Domain(final.domain)
@@ -614,13 +646,13 @@ def prepare(args, argv) -> _Setup:
         Domain(lesson.domain).check_task(lesson.task)
     check_task_kwargs(plan, args.layout, args.task_kwargs)
     check_action_change(args.task_kwargs, config)
-    check_lesson_names(plan, config, args.layout)
+    check_lesson_names(plan, config, lessons, args.layout)
     heldout_task = evaluation.check_heldout_task(domain, args.heldout_task or domain.heldout_task(final.task))
     track_task = evaluation.check_track_task(domain, args.track_task)
     run_plans = {"curriculum": plan}
     if args.baseline:
         run_plans["baseline"] = [Lesson(final.domain, final.task, sum(l.steps for l in plan))]
-    return _Setup(config, plan, domain, heldout_task, track_task, run_plans)
+    return _Setup(config, lessons, residual_scale, plan, domain, heldout_task, track_task, run_plans)
 
 
 def check_run_directory(args, setup: _Setup) -> dict:
@@ -640,7 +672,8 @@ def check_run_directory(args, setup: _Setup) -> dict:
     init = {}
     if args.init_from is not None:
         from agents.robostrich import transfer
-        source = transfer.check_source(args.init_from, setup.plan, setup.config, args.layout)
+        source = transfer.check_source(args.init_from, setup.plan, setup.config, args.layout,
+                                       residual_scale=setup.residual_scale)
         init = {"init_from": source.path, "init_digest": source.digest}
     for label in existing if args.resume else ():
         init = _check_resumed(args, setup, label, init)
@@ -659,8 +692,9 @@ def _check_resumed(args, setup: _Setup, label: str, init: dict) -> dict:
                              + ("(nor from any checkpoint)" if "init_from" not in stored else
                                 "(it started from another checkpoint, or that file has changed since)"))
         init = {**init, "init_digest": stored["init_from"]} if "init_from" in stored else {}
-    expected = run_identity(setup.run_plans[label], setup.config, args.seed, args.task_kwargs, args.layout,
-                            init.get("init_digest") if label == "curriculum" else None)
+    expected = run_identity(setup.run_plans[label], setup.config, args.seed, setup.lessons, args.task_kwargs,
+                            args.layout, init.get("init_digest") if label == "curriculum" else None,
+                            setup.residual_scale)
     checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
     for records in run_files(os.path.join(args.out, label))[1:]:
         read_records(records)  # a damaged line other than a torn last one, named
@@ -671,8 +705,8 @@ def start_runs(args, argv, setup: _Setup, init: dict):
     """The runs' specs (and, trained here, the runs themselves, restored on --resume); a run that
     died before its first checkpoint loses its records; config.json. Returns (specs, runs)."""
     specs = {label: RunSpec(label, tuple(run_plan), setup.config, args.seed, os.path.join(args.out, label),
-                            args.checkpoint_every, args.task_kwargs, args.layout,
-                            keep_lesson_checkpoints=args.keep_lesson_checkpoints,
+                            args.checkpoint_every, args.task_kwargs, args.layout, setup.lessons,
+                            setup.residual_scale, keep_lesson_checkpoints=args.keep_lesson_checkpoints,
                             **(init if label == "curriculum" else {}))  # the baseline starts from scratch
              for label, run_plan in setup.run_plans.items()}
     # Sequential: build (and restore) every run here; parallel: the workers do, once each.
@@ -686,6 +720,7 @@ def start_runs(args, argv, setup: _Setup, init: dict):
                     os.unlink(p)
     evaluation.write_json(os.path.join(args.out, "config.json"), {
         "argv": sys.argv if argv is None else list(argv), "config": setup.config.to_dict(),
+        "lessons": setup.lessons.to_dict(), "residual_scale": setup.residual_scale,
         "task_kwargs": args.task_kwargs, "layout": args.layout,
         "init_from": {"path": init.get("init_from", _previous_init_path(args.out)), "sha256": init["init_digest"]}
         if init else None,

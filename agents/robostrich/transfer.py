@@ -31,7 +31,7 @@ from agents import checkpoint
 from agents.sac.config import SACConfig
 
 # Config fields that make two networks different functions of their inputs.
-NETWORK_FIELDS = ("hidden_sizes", "critic_layer_norm", "log_std_min", "log_std_max", "residual_scale")
+NETWORK_FIELDS = ("hidden_sizes", "critic_layer_norm", "log_std_min", "log_std_max")
 
 
 class TransferError(ValueError):
@@ -203,7 +203,8 @@ def _single_domain(plan, what: str) -> str:
     return domains[0]
 
 
-def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = None, record=None) -> InitSource:
+def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = None, record=None,
+                 residual_scale: float = 0.0) -> InitSource:
     """Everything that can be checked before building the run: a readable checkpoint, of a domain that can
     start `plan`'s, with the same tendon layout and networks.  TransferError (FileNotFoundError) otherwise."""
     from agents.robostrich.runs import named_layout, parse_plan
@@ -229,6 +230,9 @@ def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = Non
         a = tuple(a) if isinstance(a, list) else a
         if a != b:
             raise TransferError(f"--init-from: {path} has other networks: its {field} is {a}, this run's {b}")
+    if fingerprint.get("residual_scale", 0.0) != residual_scale:
+        raise TransferError(f"--init-from: {path} has residual_scale {fingerprint.get('residual_scale', 0.0)}, "
+                            f"this run {residual_scale}")
     return InitSource(os.path.abspath(path), digest, source_domain, fingerprint)
 
 
@@ -239,7 +243,8 @@ def initialize(run, path: str, digest: Optional[str] = None) -> InitSource:
     record, found = _read(path)
     if digest is not None and found != digest:
         raise TransferError(f"--init-from: {path} has changed since this run was set up from it")
-    source = check_source(path, run.plan, run.config, run.layout, record=(record, found))
+    source = check_source(path, run.plan, run.config, run.layout, record=(record, found),
+                          residual_scale=getattr(run, "residual_scale", 0.0))
     if source.fingerprint["action_size"] != run.loop.actor.adapter.size:
         raise TransferError(f"--init-from: {path} acts with {source.fingerprint['action_size']} actions, "
                             f"this run with {run.loop.actor.adapter.size}")

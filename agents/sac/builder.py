@@ -20,22 +20,29 @@ class SACBuilder:
     def __init__(self, config: SACConfig):
         self.config = config
 
-    def make_adapter(self, env, flattener, base_policy=None) -> ActionAdapter:
-        """Policy box [-1, 1]^|A| <-> the environment's actions; with ``config.residual_scale`` > 0 a
-        residual on ``base_policy(flattener)``, a callable from a flat observation to an action."""
+    def make_adapter(self, env, flattener, residual=None) -> ActionAdapter:
+        """Policy box [-1, 1]^|A| <-> the environment's actions; with ``residual`` = (base policy
+        factory, scale) the policy's output is a correction of ``base(flattener)``'s action, within
+        ``scale`` of each action's half-range (agents/actors.ResidualAdapter)."""
         action_spec = env.action_spec()
         if len(action_spec.shape) != 1:
             raise ValueError(f"expected a flat action spec, got shape {action_spec.shape}")
-        if self.config.residual_scale > 0:
-            if base_policy is None:
-                raise ValueError("residual_scale > 0 needs a base policy to add the residual to")
-            return ResidualAdapter(action_spec, base_policy(flattener), self.config.residual_scale)
+        if residual is not None:
+            base_policy, scale = residual
+            if not 0.0 < scale <= 2.0:
+                raise ValueError(f"a residual's scale must be in (0, 2], got {scale}")
+            if self.config.her_ratio > 0:
+                raise ValueError("a residual policy and her_ratio do not mix: a relabelled goal changes the base "
+                                 "policy's action, so the stored residual would no longer mean what it did "
+                                 "(her_ratio=0, --her-ratio 0)")
+            return ResidualAdapter(action_spec, base_policy(flattener), scale)
         return ActionAdapter(action_spec)
 
-    def make_networks(self, observation_size: int, action_size: int):
+    def make_networks(self, observation_size: int, action_size: int, residual: bool = False):
+        """The networks; a residual policy's mean starts at zero (the base's action)."""
         cfg = self.config
         return make_networks(observation_size, action_size, cfg.hidden_sizes, cfg.log_std_min, cfg.log_std_max,
-                             cfg.critic_layer_norm, zero_policy_mean=cfg.residual_scale > 0)
+                             cfg.critic_layer_norm, zero_policy_mean=residual)
 
     def make_learner(self, networks, key) -> SACLearner:
         return SACLearner(networks, self.config, key)
@@ -51,12 +58,12 @@ class SACBuilder:
     def make_actor(self, networks, adapter, params, key=None, deterministic: bool = False) -> Actor:
         return Actor(networks, adapter, params, key=key, deterministic=deterministic)
 
-    def make_components(self, env, seed: int, base_policy=None, episode_probe=None) -> EnvironmentLoop:
+    def make_components(self, env, seed: int, residual=None, episode_probe=None) -> EnvironmentLoop:
         """All of the above for `env`, wired into the loop that owns them (what a lesson plan runs);
-        ``episode_probe(env)``: metrics an episode's record gets from its last state."""
+        ``residual``: see make_adapter; ``episode_probe(env)``: metrics an episode's record gets from its last state."""
         flattener = ObservationFlattener(env.observation_spec())
-        adapter = self.make_adapter(env, flattener, base_policy)
-        networks = self.make_networks(flattener.size, adapter.size)
+        adapter = self.make_adapter(env, flattener, residual)
+        networks = self.make_networks(flattener.size, adapter.size, residual is not None)
         learner_key, actor_key = jax.random.split(jax.random.PRNGKey(seed))
         learner = self.make_learner(networks, learner_key)
         replay = self.make_replay(env, flattener, adapter.size, seed)

@@ -44,36 +44,18 @@ class SACConfig:
     critic_layer_norm: bool = True  # LayerNorm in every hidden layer of both critics
     # Hindsight relabelling (HER, "future" strategy) on tasks with the goal interface (agents/goals.py;
     # other tasks get none): this fraction of every sampled batch gets a goal reached later in the
-    # same episode, with the reward recomputed exactly. `her_lessons` names the lesson tasks that
-    # get it (empty = every task); why the first lesson only: docs/learning.md.
+    # same episode, with the reward recomputed exactly (a curriculum may name the lessons that get
+    # it: agents/curriculum.LessonSettings).
     her_ratio: float = 0.5
-    her_lessons: Tuple[str, ...] = ("lesson1",)
     # Relabel only with reached poses that are goals the lesson could set (within the task's
     # attitude tolerance where its reward asks for one; GoalRelabeler.settable).
     her_level_goals: bool = False
-    # Lessons that train with `long_horizon_discount` instead of `discount` (empty: none), for
-    # lessons whose manoeuvres take longer than the discount looks ahead (0.99 at 125 Hz: 0.8 s).
-    long_horizon_lessons: Tuple[str, ...] = ()
-    long_horizon_discount: float = 0.995
-    # Lessons that train toward `exploration_target_entropy_per_action` x |A| instead of the
-    # target entropy above (empty: none): wider noise for a manoeuvre the policy's narrow noise
-    # never tries, or narrower noise where precision matters more than search.
-    exploration_lessons: Tuple[str, ...] = ()
-    exploration_target_entropy_per_action: float = -1.0
-    # ... and explore there with noise correlated over control steps (AR(1) coefficient per step
-    # of the policy Gaussian's standard normal draw; 0 = white noise, as plain SAC): a swing of
-    # 50 control steps is not something independent noise at every step produces.
-    exploration_noise_correlation: float = 0.0
     # Recompute every sampled transition's reward with the current lesson's reward function
     # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
     # replay then carry lesson-2 rewards instead of the ones they were collected with.
     relabel_rewards: bool = True
-    # Residual policy on a base policy the builder is given: the action is the base's plus this
-    # fraction of each action's half-range times the policy's output (0 = off: the policy
-    # outputs the whole action).
-    residual_scale: float = 0.0
     # Weight of a penalty on the squared deterministic action in the actor loss (times the
-    # critic's mean |Q|, as TD3+BC): keeps a residual policy at its base unless the critic
+    # critic's mean |Q|, as TD3+BC): keeps a residual policy (SACBuilder) at its base unless the critic
     # clearly prefers a correction (0 = off, plain SAC's actor loss; 0.4 is TD3+BC's alpha = 2.5).
     action_anchor: float = 0.0
     # Weight of a penalty on the squared pre-tanh mean of the policy in the actor loss (the
@@ -96,8 +78,6 @@ class SACConfig:
     # plain EMA.  From 100k updates on the rate is policy_average itself.
     policy_average_fraction: float = 0.1
 
-    # Fields that name lesson tasks (tuples here, lists in a fingerprint).
-    LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons", "exploration_lessons")
 
     # Upper bounds of the sizes (generous: far beyond any run measured; they keep a typo from
     # asking for days of updates or terabytes of replay).
@@ -133,26 +113,10 @@ class SACConfig:
             raise ValueError(f"tau must be in (0, 1], got {self.tau}")
         if not 0.0 <= self.her_ratio <= 1.0:
             raise ValueError(f"her_ratio must be in [0, 1], got {self.her_ratio}")
-        if not 0.0 <= self.residual_scale <= 2.0:
-            raise ValueError(f"residual_scale must be in [0, 2] (0 = no residual), got {self.residual_scale}")
-        for name in self.LESSON_LIST_FIELDS:
-            lessons = getattr(self, name)
-            if isinstance(lessons, str) or not all(isinstance(t, str) and t for t in lessons):
-                raise ValueError(f"{name} must be a tuple of task names, e.g. ('lesson1',), got {lessons!r}")
-            object.__setattr__(self, name, tuple(lessons))
-        for name in ("discount", "long_horizon_discount"):
-            if not 0.0 < getattr(self, name) <= 1.0:
-                raise ValueError(f"{name} must be in (0, 1], got {getattr(self, name)}")
-        if self.residual_scale > 0 and self.her_ratio > 0:
-            raise ValueError("residual_scale and her_ratio do not mix: a relabelled goal changes the base policy's "
-                             "base action, so the stored residual would no longer mean what it did "
-                             "(pass her_ratio=0, --her-ratio 0)")
-        for name in ("target_entropy_per_action", "exploration_target_entropy_per_action"):
-            if not np.isfinite(getattr(self, name)):
-                raise ValueError(f"{name} must be finite, got {getattr(self, name)}")
-        if not 0.0 <= self.exploration_noise_correlation < 1.0:
-            raise ValueError("exploration_noise_correlation must be in [0, 1) (0 = white noise), "
-                             f"got {self.exploration_noise_correlation}")
+        if not 0.0 < self.discount <= 1.0:
+            raise ValueError(f"discount must be in (0, 1], got {self.discount}")
+        if not np.isfinite(self.target_entropy_per_action):
+            raise ValueError(f"target_entropy_per_action must be finite, got {self.target_entropy_per_action}")
         if not 0.0 <= self.policy_average < 1.0:
             raise ValueError(f"policy_average must be a rate in [0, 1) (0 = off), got {self.policy_average}")
         if not 0.0 <= self.policy_average_fraction <= 1.0:
@@ -170,24 +134,6 @@ class SACConfig:
     def update_to_data_ratio(self) -> float:
         return self.updates_per_call / self.env_steps_per_call
 
-    def her_ratio_in_lesson(self, task: str) -> float:
-        """The hindsight share of the batches while training on ``task`` (e.g. "lesson1")."""
-        return self.her_ratio if not self.her_lessons or task in self.her_lessons else 0.0
-
-    def discount_in_lesson(self, task: str) -> float:
-        """The discount while training on ``task``: ``long_horizon_discount`` in the named lessons."""
-        return self.long_horizon_discount if task in self.long_horizon_lessons else self.discount
-
-    def target_entropy_in_lesson(self, task: str, action_size: int) -> float:
-        """The entropy the temperature steers to while training on ``task``."""
-        if task in self.exploration_lessons:
-            return self.exploration_target_entropy_per_action * float(action_size)
-        return self.resolved_target_entropy(action_size)
-
-    def noise_correlation_in_lesson(self, task: str) -> float:
-        """The exploration noise's correlation per control step while training on ``task``."""
-        return self.exploration_noise_correlation if task in self.exploration_lessons else 0.0
-
     def resolved_target_entropy(self, action_size: int) -> float:
         if self.target_entropy is not None:
             return float(self.target_entropy)
@@ -196,8 +142,6 @@ class SACConfig:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d["hidden_sizes"] = list(self.hidden_sizes)
-        for name in self.LESSON_LIST_FIELDS:
-            d[name] = list(getattr(self, name))
         return d
 
     @classmethod
@@ -209,10 +153,8 @@ class SACConfig:
                       target_entropy_per_action=-1.0,
                       init_temperature=1.0, hidden_sizes=(256, 256), min_replay_size=10_000,
                       max_replay_size=1_000_000, updates_per_call=8, env_steps_per_call=8, action_repeat=1,
-                      reward_scale=1.0, critic_layer_norm=False, her_ratio=0.0, her_lessons=(),
-                      her_level_goals=False, relabel_rewards=False,
-                      residual_scale=0.0,
-                      action_anchor=0.0, pre_tanh_penalty=0.0, policy_average=0.0)
+                      reward_scale=1.0, critic_layer_norm=False, her_ratio=0.0,
+                      her_level_goals=False, relabel_rewards=False, action_anchor=0.0, pre_tanh_penalty=0.0, policy_average=0.0)
         values.update(overrides)
         return cls(**values)
 
@@ -227,7 +169,6 @@ class SACConfig:
         unknown = set(d) - fields
         if unknown:
             raise ValueError(f"unknown SACConfig fields: {sorted(unknown)}")
-        for name in ("hidden_sizes", *cls.LESSON_LIST_FIELDS):
-            if name in d:
-                d[name] = tuple(d[name])
+        if "hidden_sizes" in d:
+            d = {**d, "hidden_sizes": tuple(d["hidden_sizes"])}
         return cls(**d)
