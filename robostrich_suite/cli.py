@@ -30,6 +30,7 @@ from typing import Callable, Optional, Sequence
 
 USER_ERROR = 2
 INTERRUPTED = 130
+CHECKPOINT_WRITTEN = "checkpoint written"  # how an interrupt that saved its work begins its message
 
 # Generous but finite limits of what a flag may ask for.
 MAX_COUNT = 10_000_000  # samples, targets, rollouts: more than a day of simulation on 2 cores
@@ -108,8 +109,9 @@ def run(main: Callable, prog: str, argv: Optional[Sequence[str]] = None) -> int:
     try:
         main(argv)
         status, detail = (INTERRUPTED if _interrupted else 0), ""  # a library swallowed the KeyboardInterrupt
-    except KeyboardInterrupt as error:
-        status, detail = INTERRUPTED, error_message(error) if str(error) else ""
+    except KeyboardInterrupt as error:  # the one detail worth a word: where a checkpoint went (a
+        # library may wrap the interrupt in its own context, which says nothing to the user)
+        status, detail = INTERRUPTED, error_message(error) if str(error).startswith(CHECKPOINT_WRITTEN) else ""
     except (ValueError, OSError) as error:
         sys.stdout.flush()
         print(f"{prog}: error: {error_message(error)}", file=sys.stderr)

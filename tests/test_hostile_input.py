@@ -124,11 +124,13 @@ def test_damaged_files_are_named_in_one_line(tmp_path):
 def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
     """Two workers (the default): a second run in the same --out is refused while the first holds
     it; Ctrl-C checkpoints both runs and exits 130; --resume drops a torn last metrics line and
-    finishes with a metrics line for every step, episodes cut by a lesson's end included."""
+    finishes with a metrics line for every step, episodes cut by a lesson's end included. Long
+    enough (5,800 steps) that Ctrl-C after the first episode always lands mid-training."""
+    train = [("lesson1:2900,lesson2:2900" if a == "lesson1:300,lesson2:300" else a) for a in TRAIN]
     out = tmp_path / "run"
-    first = start("robostrich-train", *TRAIN, "--out", out)
+    first = start("robostrich-train", *train, "--out", out)
     wait_for(lambda: (out / ".lock").exists() and (out / ".lock").read_text().strip(), "the run's lock")
-    second = finish(start("robostrich-train", *TRAIN, "--seed", "1", "--out", out))
+    second = finish(start("robostrich-train", *train, "--seed", "1", "--out", out))
     one_line_error(second, str(out), "in use")
     wait_for(lambda: (out / "curriculum" / "metrics.jsonl").exists() and first.poll() is None
              and (out / "curriculum" / "metrics.jsonl").stat().st_size > 0, "the first episode")
@@ -142,8 +144,8 @@ def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
     for label in ("curriculum", "baseline"):
         record = checkpoint._read_record(str(out / label / "checkpoint.pkl"))
         steps[label] = record["payload"]["loop"]["env_steps"]
-        assert 0 < steps[label] <= 600, steps
-    assert steps["curriculum"] < 600 or steps["baseline"] < 600  # stopped early, not at the plan's end
+        assert 0 < steps[label] <= 5800, steps
+    assert steps["curriculum"] < 5800 or steps["baseline"] < 5800  # stopped early, not at the plan's end
 
     missing = tmp_path / "missing"  # checkpoints with a valid checksum but no learner: a worker's one line
     shutil.copytree(out, missing)
@@ -152,15 +154,15 @@ def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
         record = checkpoint._read_record(str(path))
         checkpoint.save(str(path), {k: v for k, v in record["payload"].items() if k != "learner"},
                         record["fingerprint"])
-    rejected = start("robostrich-train", *TRAIN, "--out", missing, "--resume")
+    rejected = start("robostrich-train", *train, "--out", missing, "--resume")
     torn = out / "curriculum" / "metrics.jsonl"
     with open(torn, "a") as f:
-        f.write('{"env_steps": 599, "return": -3')  # a crash in mid-write
-    resumed = finish(start("robostrich-train", *TRAIN, "--no-baseline", "--out", out, "--resume"))
+        f.write('{"env_steps": 5799, "return": -3')  # a crash in mid-write
+    resumed = finish(start("robostrich-train", *train, "--no-baseline", "--out", out, "--resume"))
     assert resumed.returncode == 0, resumed.stderr[-3000:]
     records = [json.loads(line) for line in torn.read_text().splitlines()]
-    assert sum(r["length"] for r in records) == 600 and records[-1]["env_steps"] == 600, records
-    assert [r["env_steps"] for r in records if r.get("cut")] == [300, 600]  # lesson 1's last episode, cut
+    assert sum(r["length"] for r in records) == 5800 and records[-1]["env_steps"] == 5800, records
+    assert [r["env_steps"] for r in records if r.get("cut")] == [2900, 5800]  # each lesson's last episode, cut
     one_line_error(finish(rejected), "checkpoint.pkl", "learner")
 
 
