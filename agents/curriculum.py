@@ -286,16 +286,15 @@ class CurriculumRun:
         When `stop_requested()` turns true (polled between chunks: a Ctrl-C handler's flag, say) a
         checkpoint is written, then KeyboardInterrupt raised.
         An episode a lesson's end cuts off gets its metrics line too (``"cut": true``)."""
-        self._stop_requested = stop_requested
-        self._run(progress, on_eval, eval_at, stop_at_step, chunk)
+        self._run(progress, on_eval, eval_at, stop_at_step, chunk, stop_requested)
 
-    def _stop_if_interrupted(self, metrics_file):
-        if self._stop_requested():
+    def _stop_if_interrupted(self, metrics_file, stop_requested):
+        if stop_requested():
             metrics_file.flush()
             self.save_checkpoint()
             raise KeyboardInterrupt(f"checkpoint written at step {self.loop.env_steps}: {self.checkpoint_path}")
 
-    def _run(self, progress, on_eval, eval_at, stop_at_step, chunk):
+    def _run(self, progress, on_eval, eval_at, stop_at_step, chunk, stop_requested):
         loop = self.loop
         eval_at = sorted(set(int(s) for s in eval_at))
         metrics_file = open(self.metrics_path, "a")
@@ -312,7 +311,7 @@ class CurriculumRun:
 
         try:
             while not self.done:
-                self._stop_if_interrupted(metrics_file)
+                self._stop_if_interrupted(metrics_file, stop_requested)
                 lesson = self.plan[self.lesson_index]
                 n = min(chunk, lesson.steps - self.lesson_steps)
                 n = min(n, self.checkpoint_every - loop.env_steps % self.checkpoint_every)
@@ -345,7 +344,7 @@ class CurriculumRun:
                 if crossed(before, loop.env_steps, self.checkpoint_every) or self.done:
                     metrics_file.flush()
                     self.save_checkpoint()
-            self._stop_if_interrupted(metrics_file)
+            self._stop_if_interrupted(metrics_file, stop_requested)
         finally:
             metrics_file.close()
 

@@ -87,7 +87,7 @@ class GymnasiumEnv(gymnasium.Env):
 
     def to_dm_action(self, action) -> np.ndarray:
         """The dm_env action (contractions in metres) for a gymnasium action."""
-        from robostrich_suite.tasks.reach import validate_action
+        from robostrich_suite.tasks.actions import validate_action
         action = validate_action(action, self._action_low.size)
         if not self.normalize_actions:
             return action

@@ -2,6 +2,7 @@
 import numpy as np
 import pytest
 
+from robostrich_suite.model import legs
 from robostrich_suite.model import quadruped as quad
 from robostrich_suite.studies import gait_generation
 from robostrich_suite.tasks import gait
@@ -11,18 +12,18 @@ def test_leg_ik_inverts_fk_over_the_workspace():
     rng = np.random.default_rng(0)
     hip = rng.uniform(0.2, 1.5, 200)
     knee = rng.uniform(-2.6, -1.0, 200)
-    x, z = gait.leg_fk(hip, knee)
-    hip2, knee2 = gait.leg_ik(x, z)
+    x, z = legs.leg_fk(hip, knee)
+    hip2, knee2 = legs.leg_ik(x, z)
     np.testing.assert_allclose(hip2, hip, atol=1e-9)
     np.testing.assert_allclose(knee2, knee, atol=1e-9)
     # The per-step path (4 feet, plain floats) agrees with the vectorised one.
-    few = gait.leg_ik(x[:4], z[:4])
+    few = legs.leg_ik(x[:4], z[:4])
     np.testing.assert_allclose(few[0], hip2[:4], atol=1e-12)
     np.testing.assert_allclose(few[1], knee2[:4], atol=1e-12)
 
 
 def test_standing_targets_are_the_a1_standing_pose():
-    depth = -gait.leg_fk(0.9, -1.8)[1]
+    depth = -legs.leg_fk(0.9, -1.8)[1]
     targets = gait.Standing().joint_targets(0.0, depth + quad.FOOT_RADIUS)
     np.testing.assert_allclose(targets, quad.STANDING_TARGETS, atol=1e-9)
     assert quad.standing_hip_height() == pytest.approx(quad.STANDING_TRUNK_HEIGHT, abs=0.002)
@@ -51,7 +52,7 @@ def test_trot_targets_follow_the_trunk_height_command():
     trot = gait.TrotGait(stride=0.0, lift=0.0)
     for height in (0.2, 0.3):
         targets = trot.joint_targets(0.1, trunk_height=height)
-        _, z = gait.leg_fk(targets[1::3], targets[2::3])
+        _, z = legs.leg_fk(targets[1::3], targets[2::3])
         np.testing.assert_allclose(z, -(height - quad.FOOT_RADIUS), atol=1e-12)
     with pytest.raises(ValueError, match="trunk height"):
         trot.joint_targets(0.0, trunk_height=0.45)
@@ -91,14 +92,14 @@ def test_replay_applies_a_new_trunk_height_by_moving_the_feet():
     replay = gait.GaitReplay.from_file()
     t = np.linspace(0, 1, 13)
     lowered = replay.joint_targets(t, trunk_height=0.22)
-    x0, z0 = gait.leg_fk(replay.raw_targets(t)[:, 1::3], replay.raw_targets(t)[:, 2::3])
-    x1, z1 = gait.leg_fk(lowered[:, 1::3], lowered[:, 2::3])
+    x0, z0 = legs.leg_fk(replay.raw_targets(t)[:, 1::3], replay.raw_targets(t)[:, 2::3])
+    x1, z1 = legs.leg_fk(lowered[:, 1::3], lowered[:, 2::3])
     # Feet are interpolated in Cartesian space, joints in joint space: equal to ~0.1 mm.
     np.testing.assert_allclose(x1, x0, atol=2e-4)
     np.testing.assert_allclose(z1 - z0, replay.recorded_trunk_height - 0.22, atol=2e-4)
     at_samples = replay.joint_targets(replay.times, trunk_height=0.22)
-    xs, zs = gait.leg_fk(at_samples[:, 1::3], at_samples[:, 2::3])
-    np.testing.assert_allclose(zs, gait.leg_fk(replay.targets[:, 1::3], replay.targets[:, 2::3])[1]
+    xs, zs = legs.leg_fk(at_samples[:, 1::3], at_samples[:, 2::3])
+    np.testing.assert_allclose(zs, legs.leg_fk(replay.targets[:, 1::3], replay.targets[:, 2::3])[1]
                                + (replay.recorded_trunk_height - 0.22), atol=1e-9)
 
 
@@ -107,8 +108,8 @@ def test_stride_scale_scales_the_fore_aft_foot_travel():
         t = np.linspace(0, 0.4, 9)
         plain = source.joint_targets(t, 0.27)
         scaled = source.joint_targets(t, 0.27, stride_scale=np.array([1.2, 0.8, 1.0, 1.0]))
-        x0, z0 = gait.leg_fk(plain[:, 1::3], plain[:, 2::3])
-        x1, z1 = gait.leg_fk(scaled[:, 1::3], scaled[:, 2::3])
+        x0, z0 = legs.leg_fk(plain[:, 1::3], plain[:, 2::3])
+        x1, z1 = legs.leg_fk(scaled[:, 1::3], scaled[:, 2::3])
         np.testing.assert_allclose(x1, x0 * [1.2, 0.8, 1.0, 1.0], atol=1e-9)
         np.testing.assert_allclose(z1, z0, atol=1e-9)
 

@@ -10,7 +10,7 @@ import pytest
 from agents import checkpoint
 from agents.robostrich import training
 from agents.curriculum import LessonSettings, TrainingInterrupted
-from agents.robostrich.runs import DomainRun, parse_plan
+from agents.robostrich.runs import DEFAULT_LESSONS, DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
 TINY = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=200, max_replay_size=5000,
@@ -190,7 +190,7 @@ def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
     default = training.config_from_args(training.build_parser().parse_args(["--domain", "reacher"]), [])
     assert default == SACConfig()  # the CLI's defaults are the dataclass's, under the main job's on robostrich
     arm = training.config_from_args(training.build_parser().parse_args([]), [], LessonSettings)
-    assert arm == dataclasses.replace(training.TRAINING_LESSONS, **training.MAIN_JOB_CONFIG["robostrich"])
+    assert arm == dataclasses.replace(DEFAULT_LESSONS, **training.MAIN_JOB_CONFIG["robostrich"])
     paper = training.config_from_args(args, ["--paper-sac", "--batch-size", "32"], LessonSettings)
     assert paper == LessonSettings()  # nothing per lesson
     argv = ["--her-ratio", "0.5", "--her-lessons", "lesson1,lesson2", "--hidden-sizes", "32,16"]
@@ -229,7 +229,7 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     config = SACConfig()
     assert config.resolved_target_entropy(9) == -18.0 and SACConfig.paper_sac().resolved_target_entropy(9) == -9.0
     assert SACConfig(target_entropy=-3.0).resolved_target_entropy(9) == -3.0  # an explicit value wins
-    assert [training.TRAINING_LESSONS.her_ratio(t, config) for t in ("lesson1", "lesson2", "lesson3", "lesson4")] == [
+    assert [DEFAULT_LESSONS.her_ratio(t, config) for t in ("lesson1", "lesson2", "lesson3", "lesson4")] == [
         0.5, 0.0, 0.0, 0.0]
     assert not config.her_level_goals and not SACConfig.paper_sac().her_level_goals
     assert training.resolve_layout(None, arm) == "ventral_slips" == arm.layout  # the tasks' own, by name
@@ -279,7 +279,6 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
     """long_horizon_lessons: the named lesson trains with long_horizon_discount, the others with
     discount; until that lesson starts the run is bit for bit the plain one, after it differs;
     a run resumed inside the lesson keeps its discount; a misspelt lesson is an error."""
-    import dataclasses
     plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
     long = LessonSettings(long_horizon_lessons=("hard",), long_horizon_discount=0.9)
     plain = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
@@ -314,7 +313,6 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     the plain run's) and explores with correlated noise; the run is the plain one bit for bit
     until that lesson, a resumed run keeps the lesson's target and its noise state (the same run
     to the end), and a misspelt lesson or a NaN target is an error."""
-    import dataclasses
     plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
     explore = LessonSettings(exploration_lessons=("hard",), exploration_target_entropy_per_action=1.0,
                              exploration_noise_correlation=0.9)

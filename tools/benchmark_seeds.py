@@ -110,7 +110,7 @@ def _join(values):
 
 
 def write_atomic(path: str, text: str) -> None:
-    from agents.robostrich.evaluation import write_text  # the project's one atomic writer
+    from robostrich_suite.files import write_text  # the project's one atomic writer
     write_text(path, text)
 
 

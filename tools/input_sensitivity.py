@@ -97,10 +97,11 @@ def markdown(rows) -> str:
 def main(argv=None):
     args = build_parser().parse_args(argv)
     from agents.robostrich import evaluation
+    from robostrich_suite import files
     rows = measure(args.errors, args.every, args.draws, args.seed)
     os.makedirs(args.out, exist_ok=True)
     evaluation.write_json(os.path.join(args.out, "sensitivity.json"), rows)
-    evaluation.write_text(os.path.join(args.out, "sensitivity.md"), markdown(rows))
+    files.write_text(os.path.join(args.out, "sensitivity.md"), markdown(rows))
     print(markdown(rows), end="")
     return 0
 

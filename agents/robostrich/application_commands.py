@@ -56,7 +56,8 @@ def _meta(args, task: str, policies) -> dict:
 
 
 def _write(out: str, name: str, report: dict, series: dict, table: str) -> list:
-    from agents.robostrich.evaluation import write_json, write_text
+    from agents.robostrich.evaluation import write_json
+    from robostrich_suite.files import write_text
     paths = [os.path.join(out, f"{name}_report.json"), os.path.join(out, f"{name}_series.json"),
              os.path.join(out, f"{name}_summary.txt")]
     write_json(paths[0], report)

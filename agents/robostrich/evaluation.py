@@ -280,13 +280,9 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
                           heldout_task, track_task, num_targets, env_steps=0, record=record, action_repeat=1)
 
 
-def write_text(path: str, text: str) -> None:
-    """Readers never see a half-written file (robostrich_suite.files)."""
-    files.write_text(path, text)
-
-
 def write_json(path: str, obj) -> None:
-    write_text(path, json.dumps(obj, indent=1, default=_json_default))
+    """``obj`` as JSON, written whole or not at all (robostrich_suite.files)."""
+    files.write_text(path, json.dumps(obj, indent=1, default=_json_default))
 
 
 def _json_default(o):

@@ -10,7 +10,9 @@ from agents.robostrich.domains import as_domain
 from agents.sac.config import SACConfig
 
 DEFAULT_DOMAIN = "robostrich"
-# What changes with the lesson unless a run says otherwise: hindsight goals in lesson 1 only.
+# What changes with the lesson unless a run says otherwise (robostrich-train's defaults too): hindsight
+# goals in lesson 1 only (without them some seeds never learn the upper workspace; in lessons 2-3
+# they hurt: docs/learning.md).
 DEFAULT_LESSONS = LessonSettings(her_lessons=("lesson1",))
 
 
@@ -91,7 +93,8 @@ class DomainRun(curriculum.CurriculumRun):
         self.env_factory = env_factory
         self.residual_scale = float(residual_scale)
         super().__init__(plan, config, seed, run_dir, self._make_lesson_environment, checkpoint_every, name,
-                         lessons=lessons, residual=self._residual(plan), episode_probe=probes.episode_metrics, keep_lesson_checkpoints=keep_lesson_checkpoints)
+                         lessons=lessons, residual=self._residual(plan), episode_probe=probes.episode_metrics,
+                         keep_lesson_checkpoints=keep_lesson_checkpoints)
 
     def extra_identity(self) -> dict:
         """The task options, the layout and ``init_from`` (which transfer.initialize may set after building)."""

@@ -26,7 +26,7 @@ import numpy as np
 
 from agents.robostrich import evaluation
 from agents.curriculum import Lesson, LessonSettings, format_plan, read_records, run_files
-from agents.robostrich.runs import DomainRun, check_lesson_names, parse_plan, run_identity
+from agents.robostrich.runs import DEFAULT_LESSONS, DomainRun, check_lesson_names, parse_plan, run_identity
 from agents.robostrich.domains import Domain
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.sac.builder import SACBuilder
@@ -44,9 +44,6 @@ MAIN_JOB_STEPS = {"robostrich": 600_000}
 MAIN_JOB_LESSON_SHARES = {"robostrich": (4, 4, 7)}  # of the domain's curriculum, in order
 MAIN_JOB_CONFIG = {"robostrich": {"exploration_lessons": ("lesson3",),
                                   "exploration_target_entropy_per_action": -3.0}}  # LessonSettings fields
-# What changes with the lesson on every domain: hindsight goals in lesson 1 only (without them
-# some seeds never learn the upper workspace; in lessons 2-3 they hurt: docs/learning.md).
-TRAINING_LESSONS = LessonSettings(her_lessons=("lesson1",))
 MAX_TOTAL_STEPS = 100_000_000  # per run: about three days on 2 CPU cores
 # On the arm domains the main job trains the tasks' own routing, the reconstruction of the paper's
 # Fig. 1B (robostrich_suite.model.layouts.DEFAULT); `--layout antagonist_pairs` trains the best
@@ -244,8 +241,9 @@ def build_parser():
 def add_agent_arguments(p) -> None:
     """The agent's settings (SACConfig), what changes per lesson (LessonSettings), the residual and --paper-sac."""
     add_config_arguments(p.add_argument_group("SAC (defaults: agents/sac/config.py)"), SACConfig())
-    lessons = p.add_argument_group("per lesson (agents/curriculum.py LessonSettings; defaults: TRAINING_LESSONS)")
-    add_config_arguments(lessons, TRAINING_LESSONS)
+    lessons = p.add_argument_group("per lesson (agents/curriculum.py LessonSettings; defaults: "
+                                   "agents/robostrich/runs.py DEFAULT_LESSONS)")
+    add_config_arguments(lessons, DEFAULT_LESSONS)
     lessons.add_argument("--residual-scale", type=float, default=0.0,
                          help="train a residual on the lookup's stored inputs, within this fraction of each "
                               "tendon's half-range (0, the default: the policy gives the whole input)")
@@ -254,9 +252,9 @@ def add_agent_arguments(p) -> None:
                         "flags given explicitly still apply on top")
 
 
-def _config_flags(field_name: str) -> tuple:
-    """The flag of one SACConfig field: ``--field-name``."""
-    return ("--" + field_name.replace("_", "-"),)
+def _config_flag(field_name: str) -> str:
+    """The flag of one config field: ``--field-name``."""
+    return "--" + field_name.replace("_", "-")
 
 
 def _shown(value) -> str:
@@ -268,20 +266,20 @@ def add_config_arguments(group, defaults):
     the dataclass is the one home of the training defaults, the CLI only exposes them."""
     for field in dataclasses.fields(defaults):
         default = getattr(defaults, field.name)
-        flags = _config_flags(field.name)
+        flag = _config_flag(field.name)
         help_text = f"(default: {_shown(default)}"
         if field.name in MAIN_JOB_CONFIG["robostrich"]:
             help_text += f"; on robostrich: {_shown(MAIN_JOB_CONFIG['robostrich'][field.name])}"
         help_text += ")"
         if isinstance(default, bool):
-            group.add_argument(*flags, dest=field.name, action=argparse.BooleanOptionalAction,
+            group.add_argument(flag, dest=field.name, action=argparse.BooleanOptionalAction,
                                default=default, help=help_text)
         elif isinstance(default, tuple):
-            group.add_argument(*flags, dest=field.name, default=",".join(map(str, default)), help=help_text)
+            group.add_argument(flag, dest=field.name, default=",".join(map(str, default)), help=help_text)
         elif default is None:
-            group.add_argument(*flags, dest=field.name, type=float, default=None, help=help_text)
+            group.add_argument(flag, dest=field.name, type=float, default=None, help=help_text)
         else:
-            group.add_argument(*flags, dest=field.name, type=type(default), default=default, help=help_text)
+            group.add_argument(flag, dest=field.name, type=type(default), default=default, help=help_text)
 
 
 def config_from_args(args, argv=None, cls=SACConfig):
@@ -310,8 +308,7 @@ def config_from_args(args, argv=None, cls=SACConfig):
 def _with_flags(message: str) -> str:
     """``message`` with every config field name replaced by its flag(s), e.g. learning_rate -> --learning-rate."""
     import re
-    flags = {f.name: "/".join(_config_flags(f.name))
-             for cls in (SACConfig, LessonSettings) for f in dataclasses.fields(cls)}
+    flags = {f.name: _config_flag(f.name) for cls in (SACConfig, LessonSettings) for f in dataclasses.fields(cls)}
     return re.sub(r"\b(" + "|".join(sorted(flags, key=len, reverse=True)) + r")\b",
                   lambda m: flags[m.group(1)], message)
 
@@ -321,10 +318,10 @@ def _explicit_fields(argv, cls=SACConfig) -> set:
     argv = sys.argv[1:] if argv is None else list(argv)
     named = set()
     for field in dataclasses.fields(cls):
-        flags = _config_flags(field.name)
+        flag = _config_flag(field.name)
         for token in argv:
             option = token.split("=", 1)[0]
-            if option in flags or option == "--no-" + flags[0][2:]:
+            if option in (flag, "--no-" + flag[2:]):
                 named.add(field.name)
     return named
 
@@ -417,7 +414,7 @@ class RunSpec:
     checkpoint_every: int
     task_kwargs: Optional[dict]
     layout: Optional[str]
-    lessons: LessonSettings = TRAINING_LESSONS
+    lessons: LessonSettings = DEFAULT_LESSONS
     residual_scale: float = 0.0
     init_from: Optional[str] = None  # a checkpoint to start a fresh run's learner from (agents/robostrich/transfer.py)
     init_digest: Optional[str] = None  # its content hash, kept in the run's fingerprint
@@ -431,7 +428,7 @@ class RunSpec:
         """The run; restored from its checkpoint when ``restore`` and one exists (raises on a
         damaged or mismatched checkpoint, never restarts silently)."""
         run = DomainRun(list(self.plan), self.config, self.seed, self.run_dir,
-                            checkpoint_every=self.checkpoint_every, name=self.label,
+                        checkpoint_every=self.checkpoint_every, name=self.label,
                         task_kwargs=self.task_kwargs, layout=self.layout, init_from=self.init_digest,
                         keep_lesson_checkpoints=self.keep_lesson_checkpoints, lessons=self.lessons,
                         residual_scale=self.residual_scale)

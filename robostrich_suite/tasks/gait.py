@@ -45,8 +45,7 @@ import numpy as np
 
 from robostrich_suite import files
 from robostrich_suite.model import quadruped as quad
-from robostrich_suite.model.legs import (MAX_TRUNK_HEIGHT, MIN_TRUNK_HEIGHT, SAG_COMPENSATION,  # noqa: F401
-                                         assemble, check_trunk_height, foot_depth, leg_fk, leg_ik)
+from robostrich_suite.model.legs import assemble, check_trunk_height, foot_depth, leg_fk, leg_ik
 
 DATA_PATH = pathlib.Path(__file__).resolve().parents[1] / "data" / "a1_trot.csv"
 MAX_FILE_BYTES = 100_000_000  # the shipped gait file is 30 kB

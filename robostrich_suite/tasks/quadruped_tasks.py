@@ -24,7 +24,7 @@ physics, so the servos' sag under the robot's weight is not part of the episode.
 The legs' joint targets come from :mod:`robostrich_suite.tasks.gait` (default: replay of
 the shipped gait file ``data/a1_trot.csv``), written to the leg servos in
 ``before_step``; the commanded trunk height is raised by the servos' measured sag
-(``gait.SAG_COMPENSATION``) and a small steering loop keeps the walk on its start line
+(``legs.SAG_COMPENSATION``) and a small steering loop keeps the walk on its start line
 (``STEER_*``; ``steer=False`` gives the pure open-loop gait).
 
 A fallen quadruped (trunk tilted past 60 deg) or a physics divergence ends the episode.
@@ -38,10 +38,11 @@ import math
 
 import numpy as np
 
+from robostrich_suite.model import legs
 from robostrich_suite.model import quadruped as quad
 from robostrich_suite import scenes
 from robostrich_suite.tasks import gait as gait_lib
-from robostrich_suite.tasks import reach
+from robostrich_suite.tasks import reach, target_samplers
 
 SETTLE_TIME = 0.2  # s of standing physics before each fresh episode
 LESSON4_TIME_LIMIT = 6.0  # s: stand-in, lowered/raised, back (one height change)
@@ -96,7 +97,7 @@ FRAME_TO_TRUNK_OFFSET = np.array([scenes.MOUNT_OFFSET[0], scenes.NOMINAL_MOUNT_H
 
 def frame_to_trunk(frame_targets) -> np.ndarray:
     """(x, z) head positions of the arm on its frame -> (forward, up) on the standing A1."""
-    frame_targets = reach.as_targets(frame_targets, "targets")
+    frame_targets = target_samplers.as_targets(frame_targets, "targets")
     return frame_targets + FRAME_TO_TRUNK_OFFSET
 
 
@@ -187,7 +188,7 @@ class _QuadrupedTaskMixin:
 
     def leg_targets(self, physics) -> np.ndarray:
         t = self.episode_time(physics)
-        height = float(self.height_schedule(t)) + gait_lib.SAG_COMPENSATION[self.legs]
+        height = float(self.height_schedule(t)) + legs.SAG_COMPENSATION[self.legs]
         scale = self.stride_scale(physics) if self.legs == "walk" and self.steer else None
         return self.gait.joint_targets(t, height, scale)
 
@@ -300,7 +301,7 @@ class NarrowGap(_QuadrupedTaskMixin, reach.Track):
         t_stop, last = self._stopped_at
         blend = min((t - t_stop) / 0.3, 1.0)
         standing = gait_lib.Standing().joint_targets(
-            t, self.trunk_height_command(physics) + gait_lib.SAG_COMPENSATION["stand"])
+            t, self.trunk_height_command(physics) + legs.SAG_COMPENSATION["stand"])
         return (1 - blend) * last + blend * standing
 
     def walking(self) -> bool:

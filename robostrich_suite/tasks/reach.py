@@ -26,9 +26,9 @@ from dm_env import specs
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.tasks import randomization as randomization_lib
 from robostrich_suite.tasks import rewards
-from robostrich_suite.tasks.actions import check_action, validate_action  # noqa: F401 (the tasks' action)
-from robostrich_suite.tasks.starts import INITIAL_STATES, RELEASE_TIME, StartDistribution, check_initial_state  # noqa: F401
-from robostrich_suite.tasks.target_samplers import TARGET_SAMPLINGS, TargetSampler, as_targets  # noqa: F401
+from robostrich_suite.tasks.actions import check_action
+from robostrich_suite.tasks.starts import RELEASE_TIME, StartDistribution, check_initial_state
+from robostrich_suite.tasks.target_samplers import TargetSampler, as_targets
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG as DESIRED_ATTITUDE
 from robostrich_suite.tasks.conventions import LEVEL_TOLERANCE_DEG as ATTITUDE_TOLERANCE
 from robostrich_suite.tasks.conventions import POSITION_TOLERANCE
@@ -96,7 +96,7 @@ class Reach(base.Task):
         config = dataclasses.replace(config or default_config(), **overrides)
         if config.reward not in REWARDS:
             raise ValueError(f"unknown reward {config.reward!r}; use one of {REWARDS}")
-        self.starts = StartDistribution(check_initial_state(config.initial_state), config.stored_starts,
+        self.starts = StartDistribution(config.initial_state, config.stored_starts,
                                         config.fixed_stored_starts, config.start_inputs,
                                         config.release_starts, config.release_time)
         pool = config.target_pool
