@@ -5,8 +5,9 @@ goal lets the agent ask "what would this
 transition have earned had the target been g?" and get the exact answer. The
 task says where the goal sits in its observation (``GOAL_OBSERVATION``,
 ``ACHIEVED_OBSERVATION``, ``GOAL_DELTA_OBSERVATION``,
-``ATTITUDE_ERROR_OBSERVATION``) and gives the reward with ``goal_reward``; the
-agent never looks at the system itself.
+``ATTITUDE_ERROR_OBSERVATION``; ``ACHIEVED_COMPONENTS``, where the achieved observation
+holds more components than the goal, names those the goal is compared with) and gives the
+reward with ``goal_reward``; the agent never looks at the system itself.
 
 Under an action repeat a transition spans several control steps whose rewards
 are summed, so the replay keeps the achieved position and attitude error after
@@ -23,7 +24,7 @@ class GoalRelabeler:
     def __init__(self, flattener, task, slices: Optional[dict] = None):
         slices = _slices(flattener) if slices is None else slices
         self.goal = slices[task.GOAL_OBSERVATION]
-        self.achieved = slices[task.ACHIEVED_OBSERVATION]
+        self.achieved = _achieved_index(task, slices[task.ACHIEVED_OBSERVATION])
         self.delta = slices.get(task.GOAL_DELTA_OBSERVATION)
         self.attitude = slices[task.ATTITUDE_ERROR_OBSERVATION]
         self.goal_size = self.goal.stop - self.goal.start
@@ -44,8 +45,10 @@ class GoalRelabeler:
         goal, achieved = slices.get(task.GOAL_OBSERVATION), slices.get(task.ACHIEVED_OBSERVATION)
         if goal is None or achieved is None or task.ATTITUDE_ERROR_OBSERVATION not in slices:
             return None
-        if goal.stop - goal.start != achieved.stop - achieved.start:
-            return None  # e.g. a 3-D achieved position against a 2-D goal
+        if goal.stop - goal.start != len(np.arange(achieved.stop)[_achieved_index(task, achieved)]):
+            raise ValueError(f"the task's goal {task.GOAL_OBSERVATION!r} has {goal.stop - goal.start} components "
+                             f"but its achieved {task.ACHIEVED_OBSERVATION!r} {achieved.stop - achieved.start}: "
+                             "name the ones to compare in ACHIEVED_COMPONENTS")
         return cls(flattener, task, slices)
 
     def substep(self, flat_obs: np.ndarray) -> np.ndarray:
@@ -74,6 +77,19 @@ class GoalRelabeler:
         per_step = self.reward_fn(substep_goals[..., :g], substep_goals[..., g], goal[..., None, :])
         taken = np.arange(substep_goals.shape[-2]) < substeps[..., None]
         return np.sum(np.where(taken, per_step, 0.0), axis=-1)
+
+
+def _achieved_index(task, achieved: slice):
+    """The flat indices of the achieved goal: the whole observation, or the components the task
+    names in ``ACHIEVED_COMPONENTS`` (a 3-D position compared with a 2-D goal)."""
+    components = getattr(task, "ACHIEVED_COMPONENTS", None)
+    if components is None:
+        return achieved
+    index = np.arange(achieved.start, achieved.stop)
+    if not all(0 <= c < index.size for c in components):
+        raise ValueError(f"ACHIEVED_COMPONENTS {tuple(components)} outside the {index.size} components of "
+                         f"{task.ACHIEVED_OBSERVATION!r}")
+    return index[list(components)]
 
 
 def _slices(flattener) -> dict:

@@ -161,3 +161,29 @@ def test_level_goals_only_relabel_with_poses_the_lesson_could_set(run):
             assert np.any(np.all(replay.obs[:n, relabeler.goal] == goal, axis=1))  # its own target
             kept += 1
     assert relabelled > 100 and kept > 100
+
+
+def test_on_the_quadruped_hindsight_uses_the_heads_forward_and_up_components(tmp_path):
+    """The quadruped's head position is 3-D (forward, left, up) and its goal 2-D: the relabeler
+    compares the goal with (forward, up), and the rewards it recomputes are the task's."""
+    run = filled_run(tmp_path, plan="robostrich_a1/lesson2:500")
+    replay, relabeler = run.loop.replay, run.loop.relabeler
+    assert relabeler is not None and list(relabeler.achieved) == [0, 2]
+    n = len(replay)
+    recomputed = relabeler.rewards(replay.substep_goals[:n], replay.substeps[:n], replay.obs[:n, relabeler.goal])
+    np.testing.assert_allclose(recomputed, replay.reward[:n], rtol=1e-5, atol=1e-4)
+    assert np.ptp(replay.reward[:n]) > 1  # rewards that differ, not a vacuous comparison
+
+
+def test_a_goal_the_achieved_observation_cannot_be_compared_with_is_refused():
+    from agents.goals import GoalRelabeler
+    from agents.replay import ObservationFlattener
+    import robostrich_suite
+    env = robostrich_suite.load("robostrich_a1", "lesson1")
+    flattener = ObservationFlattener(env.observation_spec())
+    type(env.task).ACHIEVED_COMPONENTS, saved = None, type(env.task).ACHIEVED_COMPONENTS
+    try:
+        with pytest.raises(ValueError, match="ACHIEVED_COMPONENTS"):
+            GoalRelabeler.for_environment(env, flattener)
+    finally:
+        type(env.task).ACHIEVED_COMPONENTS = saved

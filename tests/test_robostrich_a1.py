@@ -163,6 +163,27 @@ def test_lesson3_continues_from_the_previous_episode():
     np.testing.assert_allclose(env.physics.joint_angles(), end)
 
 
+def test_stored_starts_on_the_standing_quadruped_hold_the_frames_poses():
+    """A stored start settles the arm on the standing quadruped holding a stored level pose's
+    inputs: the head comes to rest within 2 cm of where it sits on the frame (moved onto the
+    trunk), level, with the quadruped upright; the clock starts at 0."""
+    from agents.robostrich.domains import Domain
+    domain = Domain("robostrich_a1")
+    table = domain.lookup_table()
+    rows = np.arange(0, len(table["control"]), len(table["control"]) // 6)[:6]
+    env = domain.make_environment("lesson1", 0, fixed_stored_starts=1.0, start_inputs=table["control"][rows])
+    seen = set()
+    for _ in range(8):
+        ts = env.reset()
+        head = ts.observation["head_position"][[0, 2]]
+        nearest = int(np.argmin(np.linalg.norm(table["head_position"][rows] - head, axis=1)))
+        assert np.linalg.norm(table["head_position"][rows][nearest] - head) < 0.02
+        assert abs(env.task.attitude_error(env.physics)) < 5
+        assert env.physics.trunk_uprightness() > 0.99 and env.task.episode_time(env.physics) == 0.0
+        seen.add(nearest)
+    assert len(seen) >= 3
+
+
 def test_head_stabilize_target_is_pd_ahead_and_constant_height():
     env = robostrich_suite.load("robostrich_a1", "head_stabilize", task_kwargs=dict(
         random=0, distance=0.38, height=0.55))

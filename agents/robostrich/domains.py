@@ -169,10 +169,6 @@ class Domain:
         """Tendon inputs for lesson 3's ``stored_starts``: the lookup table's (so no held-out
         pose), minus every pose within `exclusion` (m) of the evaluation's moving starts, so the
         moving-start evaluation still starts where training never started."""
-        if self.on_quadruped:
-            raise ValueError("stored starts (stored_starts, fixed_stored_starts) settle the arm holding stored "
-                             "inputs on the frame; "
-                             f"{self.name!r} stands on a quadruped, where it is not supported")
         from agents.robostrich.lookup import lookup_table
         starts, _ = self.moving_starts()
         return lookup_table(self.lookup_table(), heldout=starts, exclusion=exclusion)["control"]

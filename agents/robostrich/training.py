@@ -62,17 +62,15 @@ DEFAULT_ARM_LAYOUT = layouts.DEFAULT
 # starts. Evaluation keeps the task's defaults.
 DEFAULT_ARM_TASK_KWARGS = {"weights": {"position_precision": 1.0, "attitude_precision": 0.5},
                            "target_sampling": "failures", "fixed_stored_starts": 0.25}
-# The same with lessons 1-2 starting fixed, where the stored poses (the frame arm's lookup table
-# for the layout trained) do not apply: on the quadruped, and for arms of other layouts
-# (robostrich-layouts --train).
+# The same with lessons 1-2 starting fixed, for arms whose stored poses (a layout's lookup table)
+# are not shipped: the candidate arms of robostrich-layouts --train.
 FIXED_START_ARM_TASK_KWARGS = {**DEFAULT_ARM_TASK_KWARGS, "fixed_stored_starts": 0.0}
 
 
 def default_task_kwargs(domain: Domain) -> dict:
-    """The main job's task arguments on `domain` (none off the arm)."""
-    if not domain.is_arm:
-        return {}
-    return FIXED_START_ARM_TASK_KWARGS if domain.on_quadruped else DEFAULT_ARM_TASK_KWARGS
+    """The main job's task arguments on `domain` (none off the arm): the same on the frame and on
+    the quadruped, where the arm holds the stored poses as on the frame."""
+    return DEFAULT_ARM_TASK_KWARGS if domain.is_arm else {}
 
 
 def resolve_layout(layout: Optional[str], domain: Domain) -> Optional[str]:
@@ -210,7 +208,7 @@ def build_parser():
                         f"arm domains it goes over {json.dumps(DEFAULT_ARM_TASK_KWARGS)} (weights merged key by key; "
                         "'{\"weights\": {\"position_precision\": 0, \"attitude_precision\": 0}, \"target_sampling\": \"uniform\", "
                         "\"fixed_stored_starts\": 0}' gives the paper's eq. 10, its uniform draw of targets and "
-                        "its fixed starts in lessons 1-2; on the quadruped lessons 1-2 always start fixed)")
+                        "its fixed starts in lessons 1-2)")
     p.add_argument("--keep-lesson-checkpoints", action="store_true",
                    help="also keep a checkpoint after every lesson but the last (RUN/after_lessonK.pkl), "
                         "e.g. the lesson-3 policy to compare lesson 4 with (robostrich-stabilize --reference)")

@@ -134,6 +134,10 @@ class _QuadrupedTaskMixin:
       steer: keep the walk on the start line (see ``STEER_*``); off = the pure open-loop gait.
     """
 
+    # The goal (forward, up) is compared with these components of the 3-D head position
+    # (agents/goals.py); without them hindsight goals and recomputed rewards were silently off.
+    ACHIEVED_COMPONENTS = (0, 2)
+
     def __init__(self, *, legs: str = "stand", gait=None, trunk_heights=None, steer: bool = True,
                  **kwargs):
         if legs not in ("stand", "walk"):

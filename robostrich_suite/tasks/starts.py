@@ -87,14 +87,18 @@ class StartDistribution:
 
 def hold_before_episode(physics, inputs, seconds: float) -> None:
     """Hold tendon ``inputs`` for ``seconds`` before an episode (stored and release starts); its
-    clock then starts at 0.  A divergence meanwhile leaves the fixed pose (logged like any other)."""
+    clock then starts at 0.  A divergence meanwhile puts back the state before the hold (the
+    divergence is logged like any other)."""
     steps = int(round(seconds / physics.timestep()))
     if steps < 1:
         return
+    before = (physics.data.qpos.copy(), physics.data.qvel.copy(), physics.data.act.copy(),
+              physics.arm_control())
     physics.set_arm_control(check_action(inputs, physics.arm_control_bounds()))
     physics.step(steps)
     if physics.divergence is not None:
-        physics.reset()
+        physics.divergence = None
+        restore_state(physics, before)
     physics.data.time = 0.0
 
 
