@@ -74,6 +74,18 @@ def test_seeds_aggregation_is_exact_mean_min_max():
         tool.aggregate([])
 
 
+def test_seeds_aggregation_shows_the_evaluations_at_each_lesson_end_beside_the_final():
+    tool = load_tool("benchmark_seeds")
+    summaries = [summary(1.0, 0.01, 1.0), summary(0.5, 0.02, 2.0)]
+    for s, rate in zip(summaries, (0.9, 0.7)):
+        s["lesson_ends"] = {"curriculum": {"heldout_after_lesson3": {"success_rate": rate}}, "baseline": {}}
+    agg = tool.aggregate(summaries)
+    assert agg["results"]["curriculum"]["heldout_after_lesson3"]["success_rate"]["mean"] == pytest.approx(0.8)
+    assert "heldout_after_lesson3" not in agg["results"]["baseline"]
+    assert agg["results"]["curriculum"]["heldout"]["success_rate"]["mean"] == 0.75
+    assert "| curriculum | heldout_after_lesson3 | 80.0 [70.0, 90.0] |" in tool.format_table(agg)
+
+
 def test_seeds_passes_arguments_through_resumes_and_skips_finished_seeds(tmp_path, monkeypatch):
     tool = load_tool("benchmark_seeds")
     calls = []

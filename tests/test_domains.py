@@ -119,22 +119,35 @@ def test_default_lessons_are_the_domains_curriculum():
         training.plan_from_args(parse(["--domain", "cartpole"]))
 
 
-def test_quadruped_curriculum_resumes_mid_lesson4_exactly(tmp_path):
-    """Killed while the quadruped trots (lesson 4, its trunk height schedule under way), a run
+def test_quadruped_main_job_runs_all_four_lessons_and_resumes_mid_lesson4_exactly(tmp_path):
+    """Algorithm 1 on the quadruped as robostrich-train runs it by default (lessons 1-3 standing with
+    hindsight goals in lesson 1 and stored starts, then lesson 4 trotting, in its 16:16:28:15 split),
+    at a tiny budget: killed while the quadruped trots (its trunk height schedule under way), a run
     restored from its checkpoint continues exactly as the run that was never stopped."""
     from agents.curriculum import TrainingInterrupted
-    plan = parse_plan("lesson3:40,lesson4:80", default_domain="robostrich_a1")
-    whole = DomainRun(plan, TINY, 0, str(tmp_path / "whole"), checkpoint_every=10 ** 6)
+    from agents.robostrich import training
+    args = training.build_parser().parse_args(["--domain", "robostrich_a1", "--steps", "300"])
+    plan = training.plan_from_args(args)
+    assert [(l.task, l.steps) for l in plan] == [("lesson1", 64), ("lesson2", 64), ("lesson3", 112), ("lesson4", 60)]
+    lessons = training.config_from_args(args, [], cls=training.LessonSettings)
+    options = dict(checkpoint_every=10 ** 6, lessons=lessons,
+                   task_kwargs=training.resolve_task_kwargs({}, Domain("robostrich_a1")))
+
+    def make_run(name):
+        return DomainRun(plan, TINY, 0, str(tmp_path / name), **options)
+
+    whole = make_run("whole")
     whole.run()
-    first = DomainRun(plan, TINY, 0, str(tmp_path / "killed"), checkpoint_every=10 ** 6)
+    assert whole.done and whole.loop.relabeler is not None  # hindsight goals have the head's (forward, up)
+    first = make_run("killed")
     with pytest.raises(TrainingInterrupted):
-        first.run(stop_at_step=90)  # 50 steps into lesson 4
+        first.run(stop_at_step=270)  # 30 steps into lesson 4
     assert first.lesson.task == "lesson4" and first.loop.env.task.legs == "walk"
     first.save_checkpoint()
-    resumed = DomainRun(plan, TINY, 0, str(tmp_path / "killed"), checkpoint_every=10 ** 6)
+    resumed = make_run("killed")
     resumed.restore()
     resumed.run()
-    assert resumed.loop.env_steps == whole.loop.env_steps == 120
+    assert resumed.loop.env_steps == whole.loop.env_steps == 300
     np.testing.assert_array_equal(resumed.loop.env.physics.get_state(), whole.loop.env.physics.get_state())
     for a, b in zip(jax_leaves(resumed.loop.learner.policy_params), jax_leaves(whole.loop.learner.policy_params),
                     strict=True):

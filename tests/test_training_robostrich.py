@@ -43,7 +43,7 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
     out = str(tmp_path / "run")
     training.main(["--out", out, "--plan", "lesson1:250,lesson2:250,lesson3:250", "--hidden-sizes", "32,32",
                    "--batch-size", "32", "--min-replay-size", "100", "--checkpoint-every", "300",
-                   "--num-eval-targets", "2", "--final-eval-targets", "2", "--quiet"])
+                   "--num-eval-targets", "1", "--final-eval-targets", "2", "--quiet"])
     for name in ("config.json", "summary.json", "training.rrd", "figures/learning_curves.png", "figures/track.png",
                  "curriculum/checkpoint.pkl", "baseline/checkpoint.pkl", "curriculum/metrics.jsonl",
                  "evaluation/curriculum_heldout.json", "evaluation/baseline_track.json",
@@ -67,6 +67,12 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
     assert summary["lookup"]["heldout"]["success_rate"] == 1.0  # the first two held-out targets
     evals = [json.loads(l) for l in open(os.path.join(out, "curriculum", "evals.jsonl"))]
     assert [e["env_steps"] for e in evals] == [125, 250, 375, 500, 625, 750]
+    # where a lesson ends the evaluation takes the final's targets, and summary.json keeps it by lesson
+    assert [e["summary"]["episodes"] for e in evals] == [1, 2, 1, 2, 1, 1]
+    lesson_ends = json.load(open(os.path.join(out, "summary.json")))["lesson_ends"]
+    assert lesson_ends["curriculum"] == {"heldout_after_lesson1": evals[1]["summary"],
+                                         "heldout_after_lesson2": evals[3]["summary"]}
+    assert lesson_ends["baseline"] == {}  # one lesson
     # the baseline has the same total budget, on the final lesson alone
     recorded = json.load(open(os.path.join(out, "config.json")))
     assert recorded["plans"]["baseline"] == "robostrich/lesson3:750"

@@ -64,6 +64,9 @@ def aggregate(summaries, seeds=None, minutes=None) -> dict:
     minutes = [None] * len(summaries) if minutes is None else list(minutes)
     if not len(seeds) == len(minutes) == len(summaries):
         raise ValueError("seeds, minutes and summaries differ in length")
+    # the evaluations at the end of each lesson but the last sit beside the final ones
+    summaries = [{**s, "runs": {label: {**kinds, **s.get("lesson_ends", {}).get(label, {})}
+                                for label, kinds in s["runs"].items()}} for s in summaries]
     present = {label for s in summaries for label in s["runs"]}
     labels = [l for l in LABELS if l in present] + sorted(present - set(LABELS))
     results = {}

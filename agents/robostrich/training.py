@@ -40,10 +40,12 @@ DEFAULT_TOTAL_STEPS = 480_000  # per run, split evenly over the lessons; the two
 # a narrower policy Gaussian (target entropy -3 per action instead of -2: about 1 % of an input's
 # range instead of 3 %, where a held input 1 % off already costs a target). Together they brought
 # the share of held-out targets within 1 cm and 2 deg from 62 to over 70 % (docs/learning.md).
-MAIN_JOB_STEPS = {"robostrich": 600_000}
-MAIN_JOB_LESSON_SHARES = {"robostrich": (4, 4, 7)}  # of the domain's curriculum, in order
-MAIN_JOB_CONFIG = {"robostrich": {"exploration_lessons": ("lesson3",),
-                                  "exploration_target_entropy_per_action": -3.0}}  # LessonSettings fields
+# On the quadruped (Algorithm 1 as the paper ran it) lessons 1-3 on the standing quadruped get the
+# frame's 600k, then lesson 4 (trotting, the trunk height changing) 150k more.
+MAIN_JOB_STEPS = {"robostrich": 600_000, "robostrich_a1": 750_000}
+MAIN_JOB_LESSON_SHARES = {"robostrich": (4, 4, 7), "robostrich_a1": (16, 16, 28, 15)}  # of the curriculum, in order
+_NARROW_LESSON3 = {"exploration_lessons": ("lesson3",), "exploration_target_entropy_per_action": -3.0}
+MAIN_JOB_CONFIG = {"robostrich": _NARROW_LESSON3, "robostrich_a1": _NARROW_LESSON3}  # LessonSettings fields
 MAX_TOTAL_STEPS = 100_000_000  # per run: about three days on 2 CPU cores
 # On the arm domains the main job trains the tasks' own routing, the reconstruction of the paper's
 # Fig. 1B (robostrich_suite.model.layouts.DEFAULT); `--layout antagonist_pairs` trains the best
@@ -181,9 +183,10 @@ def build_parser():
     p.add_argument("--resume", action="store_true", help="continue from the checkpoints in --out")
     p.add_argument("--domain", default="robostrich")
     p.add_argument("--steps", type=positive_int, default=None,
-                   help=f"total environment steps of the curriculum (default {MAIN_JOB_STEPS['robostrich']} on "
-                        f"robostrich, split {':'.join(map(str, MAIN_JOB_LESSON_SHARES['robostrich']))} over its "
-                        f"lessons; {DEFAULT_TOTAL_STEPS} elsewhere, split evenly)")
+                   help="total environment steps of the curriculum (default "
+                        + "; ".join(f"{MAIN_JOB_STEPS[d]} on {d}, split {':'.join(map(str, MAIN_JOB_LESSON_SHARES[d]))} "
+                                    "over its lessons" for d in MAIN_JOB_STEPS)
+                        + f"; {DEFAULT_TOTAL_STEPS} elsewhere, split evenly)")
     p.add_argument("--lessons", default=None,
                    help="lesson tasks, in order (default: the domain's curriculum: lesson1-3 on robostrich, "
                         "lesson1-4 on robostrich_a1)")
@@ -267,7 +270,7 @@ def add_config_arguments(group, defaults):
         flag = _config_flag(field.name)
         help_text = f"(default: {_shown(default)}"
         if field.name in MAIN_JOB_CONFIG["robostrich"]:
-            help_text += f"; on robostrich: {_shown(MAIN_JOB_CONFIG['robostrich'][field.name])}"
+            help_text += f"; on {' and '.join(MAIN_JOB_CONFIG)}: {_shown(MAIN_JOB_CONFIG['robostrich'][field.name])}"
         help_text += ")"
         if isinstance(default, bool):
             group.add_argument(flag, dest=field.name, action=argparse.BooleanOptionalAction,
@@ -451,6 +454,12 @@ class LookupSpec:
                                           job.final_eval_targets, record=job.record)
 
 
+def final_targets(job: RunJob) -> Optional[int]:
+    """Held-out targets of a final (or end-of-lesson) evaluation: all of the arm's unless
+    --final-eval-targets says; off the arm as many seeded episodes as the periodic ones."""
+    return job.final_eval_targets or (None if job.domain.is_arm else job.num_eval_targets)
+
+
 def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
     """Finish `run`'s plan (periodic held-out evaluations in its evals.jsonl), then its final
     evaluation (JSON reports in job.out_eval). Returns the reports and the run's counters."""
@@ -462,9 +471,13 @@ def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
 
         def on_eval(r):
             actor = SACBuilder.make_eval_actor(r.loop)
+            lesson_end = r.loop.env_steps in _boundaries(r.plan)[:-1]  # evaluated on every held-out target
+            targets = final_targets(job) if lesson_end else job.num_eval_targets
             report = evaluation.evaluate_heldout(actor, r.loop.flattener, job.domain, job.heldout_task,
-                                                 job.num_eval_targets, action_repeat=config.action_repeat)
+                                                 targets, action_repeat=config.action_repeat)
             record = {"env_steps": r.loop.env_steps, "lessons_completed": r.lesson_index, "summary": report["summary"]}
+            if lesson_end:
+                record["lesson_end"] = True
             with open(r.evals_path, "a") as f:
                 f.write(json.dumps(record) + "\n")
 
@@ -474,9 +487,8 @@ def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
                     stop_requested=cli_lib.interrupted)
         timing = {"seconds": time.time() - start, "env_steps": run.loop.env_steps - start_steps,
                   "updates": run.loop.learner.num_updates}
-    num_targets = job.final_eval_targets or (None if job.domain.is_arm else job.num_eval_targets)
     reports = evaluation.evaluate_agent(SACBuilder.make_eval_actor(run.loop), run.loop.flattener, job.out_eval,
-                                        run.name, job.domain, job.heldout_task, job.track_task, num_targets,
+                                        run.name, job.domain, job.heldout_task, job.track_task, final_targets(job),
                                         env_steps=run.loop.env_steps, record=job.record,
                                         action_repeat=config.action_repeat)
     return {"reports": reports, "env_steps": run.loop.env_steps, "updates": run.loop.learner.num_updates,
@@ -759,6 +771,14 @@ def _boundaries(plan) -> list:
     return list(np.cumsum([l.steps for l in plan]))
 
 
+def lesson_end_evaluations(records: list, plan) -> dict:
+    """``{"heldout_after_lessonK": summary}``: the evaluation on every held-out target at the end of
+    each lesson of ``plan`` but the last, from the run's evals.jsonl (the last record of each)."""
+    names = {int(end): f"heldout_after_{lesson.task}" for end, lesson in zip(_boundaries(plan)[:-1], plan)}
+    return {names[r["env_steps"]]: r["summary"] for r in records
+            if r.get("lesson_end") and r["env_steps"] in names}
+
+
 def report(args, setup: _Setup, specs: dict, outcomes: dict, lookup) -> dict:
     """Figures, the training curves' recording and summary.json (printed); returns the summary."""
     finals = {label: o["reports"] for label, o in outcomes.items()}
@@ -780,6 +800,7 @@ def report(args, setup: _Setup, specs: dict, outcomes: dict, lookup) -> dict:
         from agents.robostrich import recording
         recording.log_training_curves(os.path.join(args.out, "training.rrd"), metrics, evals)
     summary = {"runs": {label: {k: f[k]["summary"] for k in f} for label, f in finals.items()},
+               "lesson_ends": {label: lesson_end_evaluations(evals[label], spec.plan) for label, spec in specs.items()},
                "env_steps": {label: o["env_steps"] for label, o in outcomes.items()},
                "updates": {label: o["updates"] for label, o in outcomes.items()},
                "timings": {label: o["timing"] for label, o in outcomes.items() if o["timing"]}}
