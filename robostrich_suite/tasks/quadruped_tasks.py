@@ -60,10 +60,11 @@ STEER_MAX_YAW = 0.3  # rad
 STEER_MAX_STRIDE_CHANGE = 0.5  # fraction of the stride
 GAP_STOP_DISTANCE = 0.16  # m, the quadruped stops when the arm's base is this close to the wall
 
-# head_stabilize (Sec. 5.2.1): P_d and the head height above ground.
-# A level-head pose of the actuated workspace (frame pose (0.31, 0.27) on the trunk).
-HEAD_STABILIZE_DISTANCE = 0.40  # m ahead of the trunk centre
-HEAD_STABILIZE_HEIGHT = 0.56  # m above the ground
+# head_stabilize (Sec. 5.2.1): P_d and the head height above ground.  A level-head pose in the
+# middle of the default layout's densest band of level poses, the neck reaching forward over the
+# head (frame pose (0.45, 0.33) on the trunk), so holding its stored input alone keeps the head near level.
+HEAD_STABILIZE_DISTANCE = 0.54  # m ahead of the trunk centre
+HEAD_STABILIZE_HEIGHT = 0.62  # m above the ground
 # Fig. 9A: trunk height lowered during steps 500-750 and raised back during 1000-1250.
 HEAD_STABILIZE_HEIGHTS = gait_lib.TrunkHeightSchedule(
     times=(0.0, 4.0, 6.0, 8.0, 10.0),
