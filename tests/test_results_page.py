@@ -30,7 +30,8 @@ def test_readme_and_results_page_match_the_records():
 def test_every_number_of_the_readme_table_comes_from_the_main_job_record():
     record = {r["name"]: r for r in results_page.read_records()}[results_page.README_RECORD]
     readme = (ROOT / "README.md").read_text()
-    block = readme[readme.index(results_page.README_BEGIN):readme.index(results_page.README_END)]
+    begin = readme.index(results_page.README_BEGIN.format(name=results_page.README_RECORD))
+    block = readme[begin:readme.index(results_page.README_END, begin)]
     curriculum = record["seeds"]["results"]["curriculum"]["heldout"]["success_rate"]["mean"]
     assert f"| curriculum SAC | held-out, fixed start | {curriculum * 100:.1f} %" in block
 
@@ -67,3 +68,24 @@ def test_a_file_that_is_not_a_benchmark_is_refused(tmp_path):
     bad.write_text(json.dumps({"runs": {}}))
     with pytest.raises(ValueError, match="not a tools/benchmark_seeds.py seeds.json"):
         results_page.make_record("x", str(bad), "t", "c")
+
+
+def test_a_record_with_lesson_end_evaluations_gets_its_own_readme_block(tmp_path):
+    summary = _summary(0.95)
+    summary["lesson_ends"] = {"curriculum": {"heldout_after_lesson3": {
+        "success_rate": 1.0, "precise_success_rate": 0.5, "position_error_median": 0.005, "attitude_error_median": 0.4}}}
+    seeds_json = tmp_path / "seeds.json"
+    seeds_json.write_text(json.dumps(benchmark_seeds.aggregate([summary], seeds=[0], minutes=[20.0])))
+    record = results_page.make_record("quadruped", str(seeds_json), "On the quadruped", "cmd")
+    text = results_page.render_record(record)
+    assert "| curriculum SAC | held-out, fixed start, after lesson3 | 100.0 % |" in text
+    assert "(held-out fixed / moving / `track` / after lesson3 / wall-clock of the whole job): " \
+           "seed 0: 95.0 % / - / 2 of 3 track targets / 100.0 % / 20.0 min" in text
+    records = results_page.read_records() + [record]
+    readme = (ROOT / "README.md").read_text() + "\n" + results_page.README_BEGIN.format(name="quadruped") + \
+        "\nold\n" + results_page.README_END + "\n"
+    rendered = results_page.expected_files(records, readme)[results_page.README]
+    assert "old" not in rendered.split(results_page.README_BEGIN.format(name="quadruped"))[1]
+    assert "| curriculum SAC | held-out, fixed start, after lesson3 | 100.0 % |" in rendered
+    with pytest.raises(ValueError, match="no record 'missing'"):
+        results_page.expected_files(records, readme + results_page.README_BEGIN.format(name="missing"))

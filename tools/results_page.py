@@ -23,12 +23,21 @@ RECORDS = ROOT / "docs" / "results"
 PAGE = ROOT / "docs" / "results.md"
 README = ROOT / "README.md"
 FORMAT = 1
-README_BEGIN, README_END = "<!-- results: main_job (tools/results_page.py writes this table) -->", "<!-- /results -->"
-README_RECORD = "main_job"
+# A README block "<!-- results: NAME (...) --> ... <!-- /results -->" holds record NAME's table.
+README_BEGIN = "<!-- results: {name} (tools/results_page.py writes this table) -->"
+README_END = "<!-- /results -->"
+README_RECORD = "main_job"  # the README's first table; others are placed by their blocks
 
 RUNS = {"curriculum": "curriculum SAC", "baseline": "plain SAC (final lesson only)", "lookup": "lookup (no learning)"}
 KINDS = {"heldout": "held-out, fixed start", "heldout_moving": "held-out, moving starts",
          "track": "`track` (3 targets in turn)"}
+AFTER = "heldout_after_"  # the evaluation at the end of a lesson but the last
+
+
+def kind_title(kind: str) -> str:
+    if kind.startswith(AFTER):
+        return f"held-out, fixed start, after {kind[len(AFTER):]}"
+    return KINDS.get(kind, kind)
 
 
 def machine() -> str:
@@ -76,29 +85,35 @@ def seeds_table(record: dict) -> list:
              "|---|---|---|---|---|---|"]
     for label, kinds in record["seeds"]["results"].items():
         for kind, row in kinds.items():
-            lines.append(f"| {RUNS.get(label, label)} | {KINDS.get(kind, kind)} | "
+            lines.append(f"| {RUNS.get(label, label)} | {kind_title(kind)} | "
                          f"{_cell(row['success_rate'], 100, '%')} | {_cell(row['precise_success_rate'], 100, '%')} | "
                          f"{_cell(row['position_error_median'], 100, 'cm', 2)} | "
                          f"{_cell(row['attitude_error_median'], 1, 'deg', 2)} |")
     return lines
 
 
-def per_seed(record: dict) -> str:
-    """Each seed's fixed-start and moving-start success and `track` targets reached (of 3)."""
+def per_seed(record: dict) -> tuple:
+    """(what the cells are, each seed's cells): the curriculum's success in every evaluation it has
+    (`track` as targets reached of 3) and the wall-clock of the whole job."""
     agg = record["seeds"]
     curriculum = agg["results"].get("curriculum", {})
+    kinds = ["heldout", "heldout_moving"] + ["track"] * ("track" in curriculum) + sorted(
+        k for k in curriculum if k.startswith(AFTER))
     parts = []
     for i, seed in enumerate(agg["seeds"]):
         cells = []
-        for kind in ("heldout", "heldout_moving"):
+        for kind in kinds:
             values = curriculum.get(kind, {}).get("success_rate", {}).get("values", [])
-            cells.append(f"{values[i] * 100:.1f} %" if i < len(values) else "-")
-        track = curriculum.get("track", {}).get("success_rate", {}).get("values", [])
-        cells.append(f"{round(track[i] * 3)} of 3 track targets" if i < len(track) else "-")
+            if kind == "track":
+                cells.append(f"{round(values[i] * 3)} of 3 track targets" if i < len(values) else "-")
+            else:
+                cells.append(f"{values[i] * 100:.1f} %" if i < len(values) else "-")
         minutes = agg["minutes"][i]
         cells.append(f"{minutes:.1f} min" if minutes is not None else "time unknown")
         parts.append(f"seed {seed}: " + " / ".join(cells))
-    return "; ".join(parts)
+    names = {"heldout": "held-out fixed", "heldout_moving": "moving", "track": "`track`"}
+    header = " / ".join([names.get(k, f"after {k[len(AFTER):]}") for k in kinds] + ["wall-clock of the whole job"])
+    return header, "; ".join(parts)
 
 
 def budget(record: dict) -> str:
@@ -113,8 +128,8 @@ def render_record(record: dict) -> str:
              f"mean [min, max] over seeds {', '.join(map(str, agg['seeds']))}; control steps per run: {budget(record)}."]
     if record.get("note"):
         lines += ["", record["note"]]
-    lines += [""] + seeds_table(record) + ["", "Curriculum SAC per seed (held-out fixed / moving / `track` / "
-                                               "wall-clock of the whole job): " + per_seed(record) + "."]
+    header, seeds = per_seed(record)
+    lines += [""] + seeds_table(record) + ["", f"Curriculum SAC per seed ({header}): {seeds}."]
     return "\n".join(lines) + "\n"
 
 
@@ -127,7 +142,7 @@ def render_page(records: list) -> str:
 
 
 def render_readme_table(record: dict) -> str:
-    lines = [README_BEGIN,
+    lines = [README_BEGIN.format(name=record["name"]),
              f"`{record['command']}` ({record['date']}, {record['machine']}), mean [min, max] over seeds "
              f"{', '.join(map(str, record['seeds']['seeds']))}; control steps per run: {budget(record)}:", ""]
     lines += seeds_table(record)
@@ -135,18 +150,33 @@ def render_readme_table(record: dict) -> str:
     return "\n".join(lines)
 
 
-def replace_readme_table(text: str, table: str) -> str:
-    begin, end = text.find(README_BEGIN), text.find(README_END)
+def readme_blocks(text: str) -> list:
+    """The record names of the README's result blocks, in order."""
+    import re
+    pattern = re.escape(README_BEGIN).replace(re.escape("{name}"), r"([\w-]+)")
+    return re.findall(pattern, text)
+
+
+def replace_readme_table(text: str, table: str, name: str = README_RECORD) -> str:
+    begin_marker = README_BEGIN.format(name=name)
+    begin = text.find(begin_marker)
+    end = text.find(README_END, begin)
     if begin < 0 or end < begin:
-        raise ValueError(f"README.md has no '{README_BEGIN}' ... '{README_END}' block")
+        raise ValueError(f"README.md has no '{begin_marker}' ... '{README_END}' block")
     return text[:begin] + table + text[end + len(README_END):]
 
 
 def expected_files(records: list, readme_text: str) -> dict:
     by_name = {r["name"]: r for r in records}
-    if README_RECORD not in by_name:
-        raise ValueError(f"no record {README_RECORD!r} in {RECORDS} for the README's table")
-    return {PAGE: render_page(records), README: replace_readme_table(readme_text, render_readme_table(by_name[README_RECORD]))}
+    names = readme_blocks(readme_text)
+    if README_RECORD not in names:
+        names.insert(0, README_RECORD)  # and replace_readme_table says the block is missing
+    readme = readme_text
+    for name in names:
+        if name not in by_name:
+            raise ValueError(f"no record {name!r} in {RECORDS} for the README's table")
+        readme = replace_readme_table(readme, render_readme_table(by_name[name]), name)
+    return {PAGE: render_page(records), README: readme}
 
 
 def main(argv=None) -> int:

@@ -112,14 +112,15 @@ def check_residual_scale(scale: float, config: SACConfig) -> float:
     return float(scale)
 
 
-def check_action_change(task_kwargs: dict, config: SACConfig) -> None:
-    """The reward's action-change term depends on the action, not the goal: rewards the replay
-    recomputes for goals (hindsight, ``relabel_rewards``) would silently drop it, so it needs both off."""
+def check_goal_free_terms(task_kwargs: dict, config: SACConfig) -> None:
+    """The reward's action-change and head-speed terms do not depend on the goal: rewards the replay
+    recomputes for goals (hindsight, ``relabel_rewards``) would silently drop them, so they need both off."""
     weights = task_kwargs.get("weights")
-    change = weights.get("action_change", 0) if isinstance(weights, dict) else getattr(weights, "action_change", 0)
-    if change and (config.relabel_rewards or config.her_ratio > 0):
-        raise ValueError("--task-kwargs weights.action_change needs the replay to keep the rewards the task "
-                         "gave (recomputing them for goals drops the term): add --no-relabel-rewards --her-ratio 0")
+    for term in ("action_change", "head_vertical_speed"):
+        weight = weights.get(term, 0) if isinstance(weights, dict) else getattr(weights, term, 0)
+        if weight and (config.relabel_rewards or config.her_ratio > 0):
+            raise ValueError(f"--task-kwargs weights.{term} needs the replay to keep the rewards the task "
+                             "gave (recomputing them for goals drops the term): add --no-relabel-rewards --her-ratio 0")
 
 
 def lesson_text(run) -> str:
@@ -652,7 +653,7 @@ def prepare(args, argv) -> _Setup:
     for lesson in plan:  # a typo fails now, not after the first lessons have trained
         Domain(lesson.domain).check_task(lesson.task)
     check_task_kwargs(plan, args.layout, args.task_kwargs)
-    check_action_change(args.task_kwargs, config)
+    check_goal_free_terms(args.task_kwargs, config)
     check_lesson_names(plan, config, lessons, args.layout)
     heldout_task = evaluation.check_heldout_task(domain, args.heldout_task or domain.heldout_task(final.task))
     track_task = evaluation.check_track_task(domain, args.track_task)

@@ -31,6 +31,10 @@ class RewardWeights:
     ``docs/quadruped.md``) pays for it.  It depends on the action, not on the goal, so replayed
     rewards recomputed for other goals (hindsight, ``relabel_rewards``) cannot keep it: the agent
     refuses it with either on.
+
+    ``head_vertical_speed`` (per m/s, not in the paper; 0 by default) weighs the head's vertical
+    speed in the world: on the walking quadruped, the bobbing Sec. 5.2.1 asks the arm to cancel.
+    Like ``action_change`` it does not depend on the goal.
     """
     position_miss: float = 1.0
     attitude_miss: float = 1.0
@@ -41,6 +45,7 @@ class RewardWeights:
     attitude_precision: float = 0.0
     attitude_precision_scale: float = 1.0
     action_change: float = 0.0
+    head_vertical_speed: float = 0.0
 
     def __post_init__(self):
         for field in dataclasses.fields(self):
