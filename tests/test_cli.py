@@ -138,6 +138,8 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
                               "--out", tmp_path / "ln"),
         "action_change": start("robostrich-train", "--task-kwargs", '{"weights": {"action_change": 50}}',
                                "--quiet", "--out", tmp_path / "ac"),
+        "head_speed": start("robostrich-train", "--domain", "robostrich_a1", "--task-kwargs",
+                            '{"weights": {"head_vertical_speed": 5}}', "--quiet", "--out", tmp_path / "hs"),
     }
     results = {case: finish(p) for case, p in cases.items()}
     assert_user_error(results["resume_empty"], "--resume", "no checkpoint", str(empty))
@@ -159,8 +161,9 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     # The action-change term would be dropped by the default recomputed rewards: refused, named.
     assert_user_error(results["action_change"], "weights.action_change", "--no-relabel-rewards --her-ratio 0")
     assert not (tmp_path / "ac").exists()
+    assert_user_error(results["head_speed"], "weights.head_vertical_speed", "--no-relabel-rewards --her-ratio 0")
     for case in ("resume_empty", "truncated", "empty", "ramp_negative", "layout", "task", "xml_no_out",
-                 "task_kwargs", "lesson_names", "action_change"):
+                 "task_kwargs", "lesson_names", "action_change", "head_speed"):
         assert results[case].returncode == 2, (case, results[case].stderr)
 
 

@@ -184,6 +184,33 @@ def test_stored_starts_on_the_standing_quadruped_hold_the_frames_poses():
     assert len(seen) >= 3
 
 
+def test_head_vertical_speed_term_charges_the_heads_bobbing_once_it_holds_its_target():
+    """With ``weights.head_vertical_speed`` lesson 4's reward drops by the weight times the head's
+    vertical speed in the world while the head is within the position tolerance of its target (here
+    the start pose's head position); on the way to a far target it costs nothing. The motion is the
+    same as without it."""
+    start = robostrich_suite.load("robostrich_a1", "lesson4").reset().observation["head_position"][[0, 2]]
+
+    def lesson4(target, weight):
+        env = robostrich_suite.load("robostrich_a1", "lesson4", task_kwargs=dict(
+            random=0, target_pool=[target], weights={"head_vertical_speed": weight}))
+        env.reset()
+        return env
+
+    far = start + [0.3, -0.3]
+    holding, plain, reaching, plain_far = lesson4(start, 3.0), lesson4(start, 0.0), lesson4(far, 3.0), lesson4(far, 0.0)
+    speeds = []
+    for _ in range(60):
+        action = np.zeros(9)
+        charge = holding.step(action).reward - plain.step(action).reward
+        speeds.append(abs(holding.physics.head_velocity()[2]))
+        assert holding.task.position_error(holding.physics) <= holding.task.position_tolerance
+        assert charge == pytest.approx(-3.0 * speeds[-1], abs=1e-9)
+        assert reaching.step(action).reward == plain_far.step(action).reward
+        np.testing.assert_array_equal(holding.physics.data.qpos, plain.physics.data.qpos)
+    assert max(speeds) > 0.02  # the trot moves the head: a real charge, not zero against zero
+
+
 def test_head_stabilize_target_is_pd_ahead_and_constant_height():
     env = robostrich_suite.load("robostrich_a1", "head_stabilize", task_kwargs=dict(
         random=0, distance=0.38, height=0.55))

@@ -349,7 +349,7 @@ class Reach(base.Task):
                                         self.weights)
         if self.weights.action_change:
             reward -= self.weights.action_change * self._action_change
-        if self.weights.head_vertical_speed:
+        if self.weights.head_vertical_speed and error <= self.position_tolerance:  # holding, not reaching
             reward -= self.weights.head_vertical_speed * abs(float(physics.head_velocity()[2]))
         return reward
 

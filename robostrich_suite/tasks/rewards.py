@@ -33,8 +33,10 @@ class RewardWeights:
     refuses it with either on.
 
     ``head_vertical_speed`` (per m/s, not in the paper; 0 by default) weighs the head's vertical
-    speed in the world: on the walking quadruped, the bobbing Sec. 5.2.1 asks the arm to cancel.
-    Like ``action_change`` it does not depend on the goal.
+    speed in the world while the head is within the position tolerance of its target: on the
+    walking quadruped, the bobbing Sec. 5.2.1 asks the arm to cancel once it holds the target
+    (charged on the way there too, it taught the head not to move: docs/quadruped.md). Like
+    ``action_change`` the replay cannot recompute it for other goals.
     """
     position_miss: float = 1.0
     attitude_miss: float = 1.0
