@@ -217,6 +217,36 @@ def test_ctrl_c_stops_a_long_command_with_130_and_nothing_half_written(tmp_path)
     assert os.listdir(out) == []  # no report, no half-written file
 
 
+def test_ctrl_c_while_a_command_still_imports_its_libraries_is_one_line_and_130(tmp_path):
+    """The installed commands start light (agents/robostrich/commands.py) and import MuJoCo and JAX
+    inside a guard: Ctrl-C a moment after the start ends the command as Ctrl-C anywhere else does."""
+    out = tmp_path / "train"
+    process = start("robostrich-train", *TRAIN, "--out", out)
+    time.sleep(0.5)  # the interpreter is up; importing the training's libraries takes seconds
+    process.send_signal(signal.SIGINT)
+    result = finish(process)
+    assert result.returncode == 130, result.stderr[-3000:]
+    assert result.stderr.strip().splitlines() == ["robostrich-train: interrupted"], result.stderr
+    assert not out.exists()  # nothing started
+
+
+def test_the_command_launcher_loads_nothing_heavy_and_knows_every_installed_command():
+    import subprocess
+    import sys
+    code = ("import sys, agents.robostrich.commands as c; "
+            "print(sorted({m.split('.')[0] for m in sys.modules} & {'numpy', 'jax', 'mujoco', 'dm_control', "
+            "'robostrich_suite', 'matplotlib'}))")
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert loaded.strip() == "[]"
+    from importlib import metadata
+    from agents.robostrich import commands
+    installed = {e.name: e.value for e in metadata.entry_points(group="console_scripts")
+                 if e.name.startswith("robostrich-")}
+    assert set(installed) == set(commands.COMMANDS)
+    for name, value in installed.items():
+        assert getattr(commands, value.split(":")[1]).__doc__.endswith(f"({commands.COMMANDS[name]}).")
+
+
 def test_config_fields_are_checked_where_they_are_owned():
     from agents.sac.config import SACConfig
     for bad in ({"learning_rate": math.nan}, {"hidden_sizes": ()}, {"batch_size": 0}, {"reward_scale": math.inf},
