@@ -37,8 +37,12 @@ class LessonSettings:
     # ... and explore there with noise correlated over control steps (AR(1) coefficient per step
     # of the policy Gaussian's standard normal draw; 0 = white noise, as plain SAC).
     exploration_noise_correlation: float = 0.0
+    # Lessons that start with an empty replay: where the motion changes so much that the earlier
+    # lessons' transitions crowd out the new ones (a walking base after a standing one).
+    fresh_replay_lessons: Tuple[str, ...] = ()
 
-    LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons", "exploration_lessons")
+    LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons", "exploration_lessons",
+                                           "fresh_replay_lessons")
 
     def __post_init__(self):
         for name in self.LESSON_LIST_FIELDS:
@@ -73,6 +77,8 @@ class LessonSettings:
 
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
+        if not d["fresh_replay_lessons"]:  # as runs from before the field have it: their fingerprints hold
+            del d["fresh_replay_lessons"]
         return {k: list(v) if k in self.LESSON_LIST_FIELDS else v for k, v in d.items()}
 
     @classmethod
@@ -141,7 +147,8 @@ def check_lesson_names(plan, config: SACConfig, lessons: LessonSettings, other_t
     whether the plan's tasks have goals (``her_lessons`` is checked only then, as HER applies only there)."""
     named = {"her_lessons": lessons.her_lessons if config.her_ratio > 0 and goal_tasks else (),
              "long_horizon_lessons": lessons.long_horizon_lessons,
-             "exploration_lessons": lessons.exploration_lessons}
+             "exploration_lessons": lessons.exploration_lessons,
+             "fresh_replay_lessons": lessons.fresh_replay_lessons}
     known = {lesson.task for lesson in plan} | set(other_tasks)
     for field, lessons in named.items():
         unknown = sorted(set(lessons) - known)
@@ -335,6 +342,8 @@ class CurriculumRun:
                     self.lesson_steps = 0
                     if not self.done:
                         loop.set_environment(self._make_lesson_env(self.lesson_index))
+                        if self.lesson.task in self.lessons.fresh_replay_lessons:
+                            loop.replay.clear()
                         self._enter_lesson()
                         if self.keep_lesson_checkpoints:
                             self.save_checkpoint(self.lesson_checkpoint_path(self.lesson_index))

@@ -90,6 +90,12 @@ class ReplayBuffer:
         self.size = min(self.size + 1, self.capacity)
         self.total_added += 1
 
+    def clear(self):
+        """Forget every transition (a lesson that starts with an empty replay); the stream's count
+        and the sampling RNG go on, so a resumed run clears and samples as the uninterrupted one."""
+        self.size = self.insert_index = 0
+        self.episode_start = self.total_added
+
     def end_episode(self):
         """Close the open episode: hindsight goals are drawn from within it only."""
         if self.goal_width and self.total_added > self.episode_start:

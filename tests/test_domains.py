@@ -121,7 +121,8 @@ def test_default_lessons_are_the_domains_curriculum():
 
 def test_quadruped_main_job_runs_all_four_lessons_and_resumes_mid_lesson4_exactly(tmp_path):
     """Algorithm 1 on the quadruped as robostrich-train runs it by default (lessons 1-3 standing with
-    hindsight goals in lesson 1 and stored starts, then lesson 4 trotting, in its 16:16:28:15 split),
+    hindsight goals in lesson 1 and stored starts, then lesson 4 trotting from an empty replay, in its
+    16:16:28:15 split),
     at a tiny budget: killed while the quadruped trots (its trunk height schedule under way), a run
     restored from its checkpoint continues exactly as the run that was never stopped."""
     from agents.curriculum import TrainingInterrupted
@@ -139,6 +140,8 @@ def test_quadruped_main_job_runs_all_four_lessons_and_resumes_mid_lesson4_exactl
     whole = make_run("whole")
     whole.run()
     assert whole.done and whole.loop.relabeler is not None  # hindsight goals have the head's (forward, up)
+    # lesson 4 started with an empty replay: it holds the trot's transitions only
+    assert len(whole.loop.replay) == 60 // TINY.action_repeat < whole.loop.replay.total_added
     first = make_run("killed")
     with pytest.raises(TrainingInterrupted):
         first.run(stop_at_step=270)  # 30 steps into lesson 4

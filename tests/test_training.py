@@ -255,7 +255,8 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
 
 def test_main_job_on_the_arm_gives_lesson_3_the_longest_share_and_narrower_noise():
     """On robostrich the main job's curriculum is 160k / 160k / 280k control steps with lesson 3's
-    target entropy at -3 per tendon; a flag given wins, --paper-sac and other domains keep theirs."""
+    target entropy at -3 per tendon; on robostrich_a1 lesson 4 follows from an empty replay; a flag
+    given wins, --paper-sac and other domains keep theirs."""
     def made(*argv):
         args = training.build_parser().parse_args(list(argv))
         return (training.format_plan(training.plan_from_args(args)), training.config_from_args(args, list(argv)),
@@ -271,8 +272,11 @@ def test_main_job_on_the_arm_gives_lesson_3_the_longest_share_and_narrower_noise
     assert lessons.target_entropy("lesson3", config, 9) == -22.5
     assert made("--exploration-lessons", "")[2].exploration_lessons == ()
     assert made("--paper-sac")[2].exploration_lessons == ()
-    plan, config, lessons = made("--domain", "robostrich_a1")
-    assert plan.count(":120000") == 4 and lessons.exploration_lessons == ()
+    plan, config, lessons = made("--domain", "robostrich_a1")  # Algorithm 1: the same three, then lesson 4
+    assert plan == ("robostrich_a1/lesson1:160000,robostrich_a1/lesson2:160000,robostrich_a1/lesson3:280000,"
+                    "robostrich_a1/lesson4:150000")
+    assert lessons.exploration_lessons == ("lesson3",) and lessons.fresh_replay_lessons == ("lesson4",)
+    assert made("--domain", "cartpole", "--lessons", "balance")[2].exploration_lessons == ()
 
 
 def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resume(tmp_path):
