@@ -83,9 +83,11 @@ def seeds_table(record: dict) -> list:
     """Markdown rows: every run and evaluation, mean [min, max] over the seeds."""
     lines = ["| run | evaluation | success | within 1 cm and 2 deg | median position error | median attitude error |",
              "|---|---|---|---|---|---|"]
+    seeds = len(record["seeds"]["seeds"])
     for label, kinds in record["seeds"]["results"].items():
         for kind, row in kinds.items():
-            lines.append(f"| {RUNS.get(label, label)} | {kind_title(kind)} | "
+            partial = f" ({row['seeds']} of {seeds} seeds)" if row.get("seeds", seeds) != seeds else ""
+            lines.append(f"| {RUNS.get(label, label)} | {kind_title(kind)}{partial} | "
                          f"{_cell(row['success_rate'], 100, '%')} | {_cell(row['precise_success_rate'], 100, '%')} | "
                          f"{_cell(row['position_error_median'], 100, 'cm', 2)} | "
                          f"{_cell(row['attitude_error_median'], 1, 'deg', 2)} |")
