@@ -45,7 +45,8 @@ class GoalRelabeler:
         goal, achieved = slices.get(task.GOAL_OBSERVATION), slices.get(task.ACHIEVED_OBSERVATION)
         if goal is None or achieved is None or task.ATTITUDE_ERROR_OBSERVATION not in slices:
             return None
-        if goal.stop - goal.start != len(np.arange(achieved.stop)[_achieved_index(task, achieved)]):
+        index = _achieved_index(task, achieved)
+        if goal.stop - goal.start != (index.stop - index.start if isinstance(index, slice) else len(index)):
             raise ValueError(f"the task's goal {task.GOAL_OBSERVATION!r} has {goal.stop - goal.start} components "
                              f"but its achieved {task.ACHIEVED_OBSERVATION!r} {achieved.stop - achieved.start}: "
                              "name the ones to compare in ACHIEVED_COMPONENTS")

@@ -218,8 +218,9 @@ def test_ctrl_c_stops_a_long_command_with_130_and_nothing_half_written(tmp_path)
 
 
 def test_ctrl_c_while_a_command_still_imports_its_libraries_is_one_line_and_130(tmp_path):
-    """The installed commands start light (agents/robostrich/commands.py) and import MuJoCo and JAX
-    inside a guard: Ctrl-C a moment after the start ends the command as Ctrl-C anywhere else does."""
+    """The installed commands start light (agents/robostrich/commands.py) and note Ctrl-C while they
+    import MuJoCo and JAX: Ctrl-C a moment after the start ends the command as Ctrl-C anywhere else
+    does, before any work."""
     out = tmp_path / "train"
     process = start("robostrich-train", *TRAIN, "--out", out)
     time.sleep(0.5)  # the interpreter is up; importing the training's libraries takes seconds

@@ -1,12 +1,13 @@
 """The installed commands' entry points, light enough to catch Ctrl-C from the first instant.
 
 A console script imports its module before anything can handle an interrupt; ours pull in MuJoCo,
-JAX and matplotlib, which takes seconds. Each entry here imports its command's module inside a
-guard, so Ctrl-C while that happens ends the command as Ctrl-C anywhere else does: one line
+JAX and matplotlib, which takes seconds. Each entry here imports its command's module with Ctrl-C
+noted, so Ctrl-C while that happens ends the command as Ctrl-C anywhere else does: one line
 ``PROG: interrupted`` and exit status 130 (robostrich_suite/cli.py), not Python's traceback.
-Importing this module loads nothing heavy (tests/test_layers.py checks).
+Importing this module loads nothing heavy (tests/test_hostile_input.py checks).
 """
 import importlib
+import signal
 import sys
 
 INTERRUPTED = 130  # as robostrich_suite.cli.INTERRUPTED, which this module must not import
@@ -28,11 +29,18 @@ COMMANDS = {
 
 
 def launch(prog: str) -> int:
-    """Import `prog`'s module and run its cli(); Ctrl-C during the import is an interruption."""
+    """Import `prog`'s module and run its cli(). Ctrl-C during the import is noted, not raised (an
+    interrupt raised inside a native module's import can crash the interpreter, and JAX's
+    garbage-collection callback swallows one): the command ends as interrupted once the import is
+    done, before it starts any work."""
     module, function = COMMANDS[prog].split(":")
+    interrupted = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: interrupted.append(signum))
     try:
         cli = getattr(importlib.import_module(module), function)
-    except KeyboardInterrupt:
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if interrupted:
         print(f"{prog}: interrupted", file=sys.stderr)
         return INTERRUPTED
     return cli()
@@ -46,5 +54,15 @@ def _entry(prog: str):
     return entry
 
 
-train, evaluate, layouts, stabilize, gap, play, walk, export_xml, movement, workspace, targets, gait = (
-    _entry(prog) for prog in COMMANDS)
+train = _entry("robostrich-train")
+evaluate = _entry("robostrich-evaluate")
+layouts = _entry("robostrich-layouts")
+stabilize = _entry("robostrich-stabilize")
+gap = _entry("robostrich-gap")
+play = _entry("robostrich-play")
+walk = _entry("robostrich-walk")
+export_xml = _entry("robostrich-export-xml")
+movement = _entry("robostrich-movement")
+workspace = _entry("robostrich-workspace")
+targets = _entry("robostrich-targets")
+gait = _entry("robostrich-gait")
