@@ -88,7 +88,9 @@ def load(domain_name, task_name, task_kwargs=None, environment_kwargs=None, visu
     Args:
       domain_name: e.g. ``"robostrich"``; see ``TASKS_BY_DOMAIN``.
       task_name: e.g. ``"lesson2"``.
-      task_kwargs: keyword arguments of the task factory (``random`` seeds it).
+      task_kwargs: keyword arguments of the task factory (``random`` seeds it); a
+        ``tendon_layout`` may be a built-in layout's name (the layout alone; with its own
+        targets: ``task_kwargs=robostrich_suite.model.layouts.task_kwargs(name)``).
       environment_kwargs: keyword arguments of ``dm_control.rl.control.Environment``.
       visualize_reward: accepted for ``dm_control.suite.load`` compatibility; unused.
     """
@@ -100,6 +102,9 @@ def load(domain_name, task_name, task_kwargs=None, environment_kwargs=None, visu
         raise ValueError(f"domain {domain_name!r} has no task {task_name!r}; "
                          f"tasks are {list(domain.SUITE)}")
     task_kwargs = dict(task_kwargs or {})
+    if isinstance(task_kwargs.get("tendon_layout"), str):  # a built-in layout by name
+        from robostrich_suite.model import layouts
+        task_kwargs["tendon_layout"] = layouts.build(task_kwargs["tendon_layout"])
     if environment_kwargs is not None:
         task_kwargs["environment_kwargs"] = environment_kwargs
     return domain.SUITE[task_name](**task_kwargs)

@@ -225,3 +225,18 @@ def test_console_script_refuses_a_bad_file_with_one_line(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("robostrich-layouts: error: "), result.stderr
     assert "bad.json" in lines[0] and "unknown link 'c19'" in lines[0]
     assert run_layouts("--help").returncode == 0
+
+
+def test_a_layout_given_by_name_to_load_builds_that_layout_and_anything_else_is_named():
+    import robostrich_suite
+    from robostrich_suite import fingerprint as fp
+    with pytest.warns(UserWarning, match="shipped targets were made with the default arm"):
+        by_name = robostrich_suite.load("robostrich", "lesson2", task_kwargs={"tendon_layout": "antagonist_pairs"})
+    built = robostrich_suite.load("robostrich", "lesson2", task_kwargs=layouts.task_kwargs("antagonist_pairs"))
+    assert fp.compiled_fingerprint(by_name.physics.model) == fp.compiled_fingerprint(built.physics.model)
+    assert fp.compiled_fingerprint(by_name.physics.model) != fp.compiled_fingerprint(
+        robostrich_suite.load("robostrich", "lesson2").physics.model)
+    with pytest.raises(ValueError, match="nope"):
+        robostrich_suite.load("robostrich_a1", "lesson2", task_kwargs={"tendon_layout": "nope"})
+    with pytest.raises(TypeError, match="tendon layout must be a TendonLayout, got int"):
+        arm.build_arm(layout=3)

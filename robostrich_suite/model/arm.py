@@ -306,6 +306,9 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
     spec = ArmSpec.from_table1() if spec is None else spec
     spec.validate()
     layout = TendonLayout.robostrich(spec) if layout is None else layout
+    if not isinstance(layout, TendonLayout):
+        raise TypeError(f"tendon layout must be a TendonLayout, got {type(layout).__name__} {layout!r} "
+                        "(robostrich_suite.model.layouts.build(name) makes a built-in one)")
     layout.validate(spec)
 
     model = mjcf.RootElement(model=ARM_MODEL_NAME)
