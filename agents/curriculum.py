@@ -41,6 +41,15 @@ class LessonSettings:
     # lessons' transitions crowd out the new ones (a walking base after a standing one).
     fresh_replay_lessons: Tuple[str, ...] = ()
 
+    HELP: ClassVar[dict] = {  # one line per field, for a training command's --help
+        "her_lessons": "lessons that get hindsight goals, comma-separated (empty: every lesson)",
+        "long_horizon_lessons": "lessons trained with --long-horizon-discount",
+        "long_horizon_discount": "discount of the long-horizon lessons",
+        "exploration_lessons": "lessons trained toward --exploration-target-entropy-per-action",
+        "exploration_target_entropy_per_action": "target entropy per action in the exploration lessons",
+        "exploration_noise_correlation": "AR(1) correlation per step of the exploration lessons' noise (0: white)",
+        "fresh_replay_lessons": "lessons that start with an empty replay",
+    }
     LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons", "exploration_lessons",
                                            "fresh_replay_lessons")
 

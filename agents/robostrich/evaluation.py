@@ -335,14 +335,16 @@ def main(argv=None):
                                                  "held-out targets and the track task.")
     parser.add_argument("checkpoint", help="checkpoint.pkl written by robostrich-train")
     parser.add_argument("--out", default=None, help="report directory (default: next to the checkpoint)")
-    parser.add_argument("--label", default="eval")
+    parser.add_argument("--label", default="eval",
+                        help="name of this evaluation in the report files (default: %(default)s)")
     parser.add_argument("--heldout-task", default=None,
                         help="task for held-out targets (default: lesson2 on robostrich, else the last lesson)")
-    parser.add_argument("--track-task", default="track", help="'' to skip")
+    parser.add_argument("--track-task", default="track",
+                        help="task of the tracking evaluation; '' to skip it (default: %(default)s)")
     parser.add_argument("--num-targets", type=target_count, default=None,
                         help=f"held-out targets (default: all; at most {MAX_TARGETS})")
-    parser.add_argument("--no-rerun", action="store_true")
-    parser.add_argument("--no-figures", action="store_true")
+    parser.add_argument("--no-rerun", action="store_true", help="no .rrd recordings")
+    parser.add_argument("--no-figures", action="store_true", help="no PNG figures")
     args = parser.parse_args(argv)
     fingerprint = checked_fingerprint(args.checkpoint)  # every input checked before the run is rebuilt
     domain = checkpoint_domain(fingerprint)

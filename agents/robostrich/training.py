@@ -183,61 +183,72 @@ def _json_object(text: str) -> dict:
 
 def build_parser():
     p = cli_lib.Parser(description="Train curriculum SAC (and a plain-SAC baseline) on the Robostrich arm.")
-    p.add_argument("--out", default="runs/default", help="run directory")
-    p.add_argument("--resume", action="store_true", help="continue from the checkpoints in --out")
-    p.add_argument("--domain", default="robostrich")
-    p.add_argument("--steps", type=positive_int, default=None,
-                   help="total environment steps of the curriculum (default "
-                        + "; ".join(f"{MAIN_JOB_STEPS[d]} on {d}, split {':'.join(map(str, MAIN_JOB_LESSON_SHARES[d]))} "
-                                    "over its lessons" for d in MAIN_JOB_STEPS)
-                        + f"; {DEFAULT_TOTAL_STEPS} elsewhere, split evenly)")
-    p.add_argument("--lessons", default=None,
-                   help="lesson tasks, in order (default: the domain's curriculum: lesson1-3 on robostrich, "
-                        "lesson1-4 on robostrich_a1)")
-    p.add_argument("--plan", default=None,
-                   help="explicit plan '[domain/]task:steps,...' (overrides --steps/--lessons)")
-    p.add_argument("--seed", type=cli_lib.seed, default=0)
-    p.add_argument("--layout", default=None,
-                   help="built-in tendon layout of the arm; its own shipped level poses give the training and "
-                        f"held-out targets and the lookup table (default on the arm domains: {DEFAULT_ARM_LAYOUT}, "
-                        "the reconstruction of the paper's routing; antagonist_pairs: the best routing of our own)")
-    p.add_argument("--init-from", default=None, metavar="CHECKPOINT",
-                   help="start the curriculum's learner (policy, critics, target critics, optimiser states, "
-                        "temperature) from a checkpoint.pkl of robostrich-train on the same domain or, for "
-                        "--domain robostrich_a1, on robostrich (the arm on its frame): its networks are mapped "
-                        "onto the a1's observations (agents/robostrich/transfer.py). Same tendon layout and networks "
-                        "(--hidden-sizes) required; the replay is not carried (other observations); the plain-SAC "
-                        "baseline still starts from scratch, so the comparison shows what the transfer brings. "
-                        "A --resume may leave it out (the checkpoint holds the transferred state)")
-    p.add_argument("--task-kwargs", type=_json_object, default={},
-                   help="JSON object passed to every training lesson's task, e.g. eq. 10's weights: "
-                        "'{\"weights\": {\"position_error\": 10}}' (evaluation keeps the task's defaults). On the "
-                        f"arm domains it goes over {json.dumps(DEFAULT_ARM_TASK_KWARGS)} (weights merged key by key; "
-                        "'{\"weights\": {\"position_precision\": 0, \"attitude_precision\": 0}, \"target_sampling\": \"uniform\", "
-                        "\"fixed_stored_starts\": 0}' gives the paper's eq. 10, its uniform draw of targets and "
-                        "its fixed starts in lessons 1-2)")
-    p.add_argument("--keep-lesson-checkpoints", action="store_true",
-                   help="also keep a checkpoint after every lesson but the last (RUN/after_lessonK.pkl), "
-                        "e.g. the lesson-3 policy to compare lesson 4 with (robostrich-stabilize --reference)")
-    p.add_argument("--checkpoint-every", type=positive_int, default=25_000,
-                   help="environment steps between checkpoints (default: %(default)s)")
-    p.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
-                   help="also train plain SAC on the final lesson with the same total budget")
-    p.add_argument("--eval-every", type=positive_int, default=None, help="held-out evaluation period (default: steps/6)")
-    p.add_argument("--num-eval-targets", type=evaluation.target_count, default=20,
-                   help="held-out targets in the periodic evaluations (the final one uses all)")
-    p.add_argument("--final-eval-targets", type=evaluation.target_count, default=None,
-                   help="held-out targets in the final evaluation (default: all)")
-    p.add_argument("--heldout-task", default=None,
-                   help="task for held-out evaluation (default: lesson2 on robostrich, i.e. eq. 10 from the "
-                        "fixed initial pose; else the final lesson)")
-    p.add_argument("--track-task", default="track")
-    p.add_argument("--no-rerun", action="store_true")
-    p.add_argument("--no-figures", action="store_true")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS), default=min(2, os.cpu_count() or 1),
-                   help="runs trained at once, one process each (default: %(default)s; the curriculum and "
-                        "the plain-SAC baseline are independent)")
+    run = p.add_argument_group("what to train")
+    files = p.add_argument_group("run directory and checkpoints")
+    report = p.add_argument_group("evaluation and outputs")
+    files.add_argument("--out", default="runs/default", help="run directory (default: %(default)s)")
+    files.add_argument("--resume", action="store_true", help="continue from the checkpoints in --out")
+    run.add_argument("--domain", default="robostrich",
+                     help="robostrich (the arm on its frame), robostrich_a1 (on the quadruped) or a dm_control "
+                          "domain (default: %(default)s)")
+    run.add_argument("--steps", type=positive_int, default=None,
+                     help="total environment steps of the curriculum (default "
+                          + "; ".join(f"{MAIN_JOB_STEPS[d]} on {d}, split "
+                                      f"{':'.join(map(str, MAIN_JOB_LESSON_SHARES[d]))} "
+                                      "over its lessons" for d in MAIN_JOB_STEPS)
+                          + f"; {DEFAULT_TOTAL_STEPS} elsewhere, split evenly)")
+    run.add_argument("--lessons", default=None,
+                     help="lesson tasks, in order (default: the domain's curriculum: lesson1-3 on robostrich, "
+                          "lesson1-4 on robostrich_a1)")
+    run.add_argument("--plan", default=None,
+                     help="explicit plan '[domain/]task:steps,...' (overrides --steps/--lessons)")
+    run.add_argument("--seed", type=cli_lib.seed, default=0,
+                     help="random seed of networks, exploration and episodes (default: %(default)s)")
+    run.add_argument("--layout", default=None,
+                     help="built-in tendon layout of the arm; its own shipped level poses give the training and "
+                          f"held-out targets and the lookup table (default on the arm domains: {DEFAULT_ARM_LAYOUT}, "
+                          "the reconstruction of the paper's routing; antagonist_pairs: the best routing of our own)")
+    run.add_argument("--init-from", default=None, metavar="CHECKPOINT",
+                     help="start the curriculum's learner (policy, critics, target critics, optimiser states, "
+                          "temperature) from a checkpoint.pkl of robostrich-train on the same domain or, for "
+                          "--domain robostrich_a1, on robostrich (the arm on its frame): its networks are mapped "
+                          "onto the a1's observations (agents/robostrich/transfer.py). Same tendon layout and networks "
+                          "(--hidden-sizes) required; the replay is not carried (other observations); the plain-SAC "
+                          "baseline still starts from scratch, so the comparison shows what the transfer brings. "
+                          "A --resume may leave it out (the checkpoint holds the transferred state)")
+    run.add_argument("--task-kwargs", type=_json_object, default={},
+                     help="JSON object passed to every training lesson's task, e.g. eq. 10's weights: "
+                          "'{\"weights\": {\"position_error\": 10}}' (evaluation keeps the task's defaults). On the "
+                          f"arm domains it goes over {json.dumps(DEFAULT_ARM_TASK_KWARGS)} (weights merged key by key; "
+                          "'{\"weights\": {\"position_precision\": 0, \"attitude_precision\": 0}, "
+                          "\"target_sampling\": \"uniform\", "
+                          "\"fixed_stored_starts\": 0}' gives the paper's eq. 10, its uniform draw of targets and "
+                          "its fixed starts in lessons 1-2)")
+    files.add_argument("--keep-lesson-checkpoints", action="store_true",
+                       help="also keep a checkpoint after every lesson but the last (RUN/after_lessonK.pkl), "
+                            "e.g. the lesson-3 policy to compare lesson 4 with (robostrich-stabilize --reference)")
+    files.add_argument("--checkpoint-every", type=positive_int, default=25_000,
+                       help="environment steps between checkpoints (default: %(default)s)")
+    run.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
+                     help="also train plain SAC on the final lesson with the same total budget")
+    report.add_argument("--eval-every", type=positive_int, default=None,
+                        help="environment steps between held-out evaluations (default: steps/6)")
+    report.add_argument("--num-eval-targets", type=evaluation.target_count, default=20,
+                        help="held-out targets in the periodic evaluations (the final one uses all)")
+    report.add_argument("--final-eval-targets", type=evaluation.target_count, default=None,
+                        help="held-out targets in the final evaluation (default: all)")
+    report.add_argument("--heldout-task", default=None,
+                        help="task for held-out evaluation (default: lesson2 on robostrich, i.e. eq. 10 from the "
+                             "fixed initial pose; else the final lesson)")
+    report.add_argument("--track-task", default="track",
+                        help="task of the final tracking evaluation; '' to skip it (default: %(default)s)")
+    report.add_argument("--no-rerun", action="store_true", help="no .rrd recordings of the final evaluation")
+    report.add_argument("--no-figures", action="store_true", help="no PNG figures")
+    report.add_argument("--quiet", action="store_true", help="no progress bar")
+    run.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS),
+                     default=min(2, os.cpu_count() or 1),
+                     help="runs trained at once, one process each (default: %(default)s; the curriculum and "
+                          "the plain-SAC baseline are independent)")
     p.add_argument("--stop-at-step", type=positive_int, default=None, help=argparse.SUPPRESS)  # imitates a kill (tests)
     add_agent_arguments(p)
     return p
@@ -272,7 +283,7 @@ def add_config_arguments(group, defaults):
     for field in dataclasses.fields(defaults):
         default = getattr(defaults, field.name)
         flag = _config_flag(field.name)
-        help_text = f"(default: {_shown(default)}"
+        help_text = f"{type(defaults).HELP[field.name]} (default: {_shown(default)}"
         for domain, values in MAIN_JOB_CONFIG.items():
             if field.name in values:
                 help_text += f"; on {domain}: {_shown(values[field.name])}"

@@ -79,6 +79,34 @@ class SACConfig:
     policy_average_fraction: float = 0.1
 
 
+    # One line per field: what it sets (a training command's --help shows it beside the flag).
+    HELP: ClassVar[dict] = {
+        "batch_size": "transitions per gradient step",
+        "learning_rate": "Adam step size of the critics, the actor and the temperature",
+        "discount": "discount factor of the return",
+        "tau": "Polyak rate at which the target critics follow the critics",
+        "target_entropy": "entropy the temperature steers the policy to (overrides --target-entropy-per-action)",
+        "target_entropy_per_action": "target entropy per action dimension (-1: Acme's; lower: narrower noise)",
+        "init_temperature": "initial entropy temperature (alpha)",
+        "hidden_sizes": "hidden layer widths of the actor and each critic, e.g. 64,64",
+        "min_replay_size": "transitions collected before learning starts",
+        "max_replay_size": "replay capacity in transitions (oldest dropped first)",
+        "updates_per_call": "gradient steps per learner call (one jitted scan)",
+        "env_steps_per_call": "agent steps between learner calls (update-to-data ratio: updates / steps)",
+        "action_repeat": "control steps each action is held for",
+        "reward_scale": "factor on every reward the learner sees",
+        "log_std_min": "lower clip of the policy's log standard deviation",
+        "log_std_max": "upper clip of the policy's log standard deviation",
+        "critic_layer_norm": "LayerNorm in every hidden layer of both critics",
+        "her_ratio": "share of each batch given a hindsight goal reached later in its episode (0: off)",
+        "her_level_goals": "relabel only with reached poses the lesson could set as goals",
+        "relabel_rewards": "recompute sampled rewards with the current lesson's reward function",
+        "action_anchor": "weight of the actor-loss penalty that keeps a residual policy at its base (0: off)",
+        "pre_tanh_penalty": "weight of the penalty on the policy's squared pre-tanh mean (0: off)",
+        "policy_average": "rate of the moving average of the policy that is evaluated and deployed (0: off)",
+        "policy_average_fraction": "early on, the average spans this fraction of the updates so far (0: plain average)",
+    }
+
     # Upper bounds of the sizes (generous: far beyond any run measured; they keep a typo from
     # asking for days of updates or terabytes of replay).
     LIMITS: ClassVar[dict] = {"batch_size": 65_536, "updates_per_call": 1_000, "env_steps_per_call": 100_000,

@@ -13,6 +13,7 @@ import pathlib
 import numpy as np
 
 from robostrich_suite import cli as cli_lib
+from robostrich_suite.model import legs
 from robostrich_suite.tasks import gait as gait_lib
 
 
@@ -30,9 +31,14 @@ def main(argv=None) -> None:
                         help="gait file to write (the shipped one: robostrich_suite/data/a1_trot.csv)")
     parser.add_argument("--frequency", type=cli_lib.number(0.1, 20, " Hz"), default=gait_lib.TrotGait.frequency,
                         help="gait cycles per second, 0.1-20 (default: %(default)s)")
-    parser.add_argument("--stride", type=cli_lib.number(0, 0.2, " m"), default=gait_lib.TrotGait.stride)
-    parser.add_argument("--lift", type=cli_lib.number(0, 0.1, " m"), default=gait_lib.TrotGait.lift)
-    parser.add_argument("--trunk-height", type=float, default=gait_lib.TrotGait.trunk_height)
+    parser.add_argument("--stride", type=cli_lib.number(0, 0.2, " m"), default=gait_lib.TrotGait.stride,
+                        help="foot travel relative to the hip during stance, 0-0.2 m (default: %(default)s)")
+    parser.add_argument("--lift", type=cli_lib.number(0, 0.1, " m"), default=gait_lib.TrotGait.lift,
+                        help="swing foot height, 0-0.1 m (default: %(default)s)")
+    parser.add_argument("--trunk-height", default=gait_lib.TrotGait.trunk_height,
+                        type=cli_lib.number(legs.MIN_TRUNK_HEIGHT, legs.MAX_TRUNK_HEIGHT, " m"),
+                        help=f"trunk height the legs hold, {legs.MIN_TRUNK_HEIGHT}-{legs.MAX_TRUNK_HEIGHT} m "
+                             "(default: %(default)s)")
     parser.add_argument("--rate", type=cli_lib.number(1, 10_000, " samples/s"), default=100.0,
                         help="samples per second, 1-10000 (default: %(default)s)")
     args = parser.parse_args(argv)

@@ -369,7 +369,8 @@ def build_parser() -> cli_lib.Parser:
                     "ventral tendon from the base, where it does not appear (see docs/movement.md).")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/movement"),
                         help="output directory (default: %(default)s)")
-    parser.add_argument("--patterns", nargs="+", choices=PATTERNS, default=list(PATTERNS))
+    parser.add_argument("--patterns", nargs="+", choices=PATTERNS, default=list(PATTERNS),
+                        help="movement patterns to run (default: all)")
     parser.add_argument("--from-base", action="store_true",
                         help="the ventral_from_base routing (every ventral tendon from the base), dorsal length "
                              "held, successive contractions; overrides --ventral-span, "
