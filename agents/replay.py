@@ -63,6 +63,7 @@ class ReplayBuffer:
         self.insert_index = 0
         self.total_added = 0
         self.episode_start = 0  # abs index of the open episode's first transition
+        self.row_base = 0  # abs index of the transition in row 0: rows fill from 0 again after a clear
         self.rng = np.random.default_rng(seed)
 
     def __len__(self):
@@ -90,18 +91,21 @@ class ReplayBuffer:
         self.size = min(self.size + 1, self.capacity)
         self.total_added += 1
 
+    def _rows(self, abs_index):
+        """The rows holding the transitions with these positions in the stream of all additions."""
+        return (abs_index - self.row_base) % self.capacity
+
     def clear(self):
         """Forget every transition (a lesson that starts with an empty replay); the stream's count
         and the sampling RNG go on, so a resumed run clears and samples as the uninterrupted one."""
         self.size = self.insert_index = 0
-        self.episode_start = self.total_added
+        self.episode_start = self.row_base = self.total_added
 
     def end_episode(self):
         """Close the open episode: hindsight goals are drawn from within it only."""
         if self.goal_width and self.total_added > self.episode_start:
             first = max(self.episode_start, self.total_added - self.size)
-            rows = np.arange(first, self.total_added) % self.capacity
-            self.episode_last[rows] = self.total_added - 1
+            self.episode_last[self._rows(np.arange(first, self.total_added))] = self.total_added - 1
         self.episode_start = self.total_added
 
     def sample_stack(self, num_batches: int, batch_size: int, relabeler=None, her_ratio: float = 0.0,
@@ -131,7 +135,7 @@ class ReplayBuffer:
             last = self.episode_last[idx]
             last = np.where(last < 0, self.total_added - 1, last)
             future = first + np.floor(self.rng.random(idx.shape) * (last - first + 1)).astype(np.int64)
-            rows = future % self.capacity
+            rows = self._rows(future)
             reached_pose = self.substep_goals[rows, self.substeps[rows] - 1]
             if settable_goals_only:
                 her &= relabeler.settable(reached_pose)
@@ -154,7 +158,7 @@ class ReplayBuffer:
         return {"capacity": self.capacity, "obs_size": self.obs_size, "action_size": self.action_size,
                 "goal_width": self.goal_width, "repeat": self.repeat,
                 "size": n, "insert_index": self.insert_index, "rng": self.rng.bit_generator.state,
-                "total_added": self.total_added, "episode_start": self.episode_start,
+                "total_added": self.total_added, "episode_start": self.episode_start, "row_base": self.row_base,
                 **{f: getattr(self, f)[:n] for f in self.fields}}
 
     def load_state_dict(self, d: dict):
@@ -168,4 +172,5 @@ class ReplayBuffer:
         self.insert_index = d["insert_index"]
         self.total_added = d.get("total_added", n)
         self.episode_start = d.get("episode_start", self.total_added)
+        self.row_base = d.get("row_base", 0)
         self.rng.bit_generator.state = d["rng"]

@@ -187,3 +187,29 @@ def test_a_goal_the_achieved_observation_cannot_be_compared_with_is_refused():
             GoalRelabeler.for_environment(env, flattener)
     finally:
         type(env.task).ACHIEVED_COMPONENTS = saved
+
+
+def test_after_a_fresh_replay_lesson_hindsight_goals_still_come_from_the_same_episode(tmp_path):
+    """A lesson that starts with an empty replay refills it from row 0 while the stream's count
+    goes on: hindsight goals must still be poses reached later in the transition's own episode
+    (not rows the clear left behind, nor never-written zeros)."""
+    plan = parse_plan("robostrich/lesson1:500,robostrich/lesson2:1000")
+    run = DomainRun(plan, HER, seed=2, run_dir=str(tmp_path), checkpoint_every=10_000,
+                    lessons=LessonSettings(fresh_replay_lessons=("lesson2",)))
+    run.run()
+    replay, relabeler = run.loop.replay, run.loop.relabeler
+    n = len(replay)
+    assert n == 1000 // 5 and replay.abs_index[0] == 500 // 5  # refilled from row 0, the count went on
+    shadow = np.random.default_rng()
+    shadow.bit_generator.state = replay.rng.bit_generator.state
+    rows = shadow.integers(0, n, size=(1, 300))[0]
+    goals = replay.sample_stack(1, 300, relabeler, her_ratio=1.0).obs[0][:, relabeler.goal]
+    reached = replay.substep_goals[:n, -1, :2]
+    episode = replay.abs_index[:n] // 50
+    for row, goal in zip(rows, goals):
+        later = np.flatnonzero((episode == episode[row]) & (replay.abs_index[:n] >= replay.abs_index[row]))
+        assert np.any(np.all(reached[later] == goal, axis=1)), (row, goal)
+    restored = type(replay)(replay.obs_size, replay.action_size, replay.capacity, goal_width=replay.goal_width,
+                            repeat=replay.repeat)
+    restored.load_state_dict(replay.state_dict())
+    assert restored.row_base == replay.row_base == 500 // 5
