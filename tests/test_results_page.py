@@ -33,7 +33,8 @@ def test_every_number_of_the_readme_table_comes_from_the_main_job_record():
     begin = readme.index(results_page.README_BEGIN.format(name=results_page.README_RECORD))
     block = readme[begin:readme.index(results_page.README_END, begin)]
     curriculum = record["seeds"]["results"]["curriculum"]["heldout"]["success_rate"]["mean"]
-    assert f"| curriculum SAC | held-out, fixed start | {curriculum * 100:.1f} %" in block
+    assert f"| curriculum SAC | {curriculum * 100:.1f} %" in block
+    assert block.count("\n| ") == 1 + len(record["seeds"]["results"])  # header and one row per run
 
 
 def test_a_changed_number_makes_the_committed_text_stale(tmp_path):
@@ -86,6 +87,9 @@ def test_a_record_with_lesson_end_evaluations_gets_its_own_readme_block(tmp_path
         "\nold\n" + results_page.README_END + "\n"
     rendered = results_page.expected_files(records, readme)[results_page.README]
     assert "old" not in rendered.split(results_page.README_BEGIN.format(name="quadruped"))[1]
-    assert "| curriculum SAC | held-out, fixed start, after lesson3 | 100.0 % |" in rendered
+    block = rendered.split(results_page.README_BEGIN.format(name="quadruped"))[1]
+    assert "| run | held-out, fixed start | `track` | after lesson3 | within 1 cm and 2 deg | median error |" in block
+    assert "| curriculum SAC | 95.0 % | 66.7 % | 100.0 % | 47.5 % | 1.00 cm, 1.00 deg |" in block
+    assert "| lookup (no learning) | 90.0 % | - | - | 47.5 % | 1.00 cm, 1.00 deg |" in block
     with pytest.raises(ValueError, match="no record 'missing'"):
         results_page.expected_files(records, readme + results_page.README_BEGIN.format(name="missing"))

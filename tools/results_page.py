@@ -143,11 +143,36 @@ def render_page(records: list) -> str:
     return "\n".join([head] + [render_record(r) for r in records])
 
 
+SHORT_KINDS = {"heldout": "held-out, fixed start", "heldout_moving": "moving starts", "track": "`track`"}
+
+
+def short_table(record: dict) -> list:
+    """The README's rows: one per run, the success of each evaluation (of the lesson ends, the last)
+    and, from the fixed start, the precise share and the median errors; the page has every row."""
+    results, seeds = record["seeds"]["results"], len(record["seeds"]["seeds"])
+    present = {kind for kinds in results.values() for kind in kinds}
+    after = sorted(k for k in present if k.startswith(AFTER))[-1:]
+    kinds = [k for k in SHORT_KINDS if k in present] + after
+    titles = [SHORT_KINDS.get(k, f"after {k[len(AFTER):]}") for k in kinds]
+    lines = ["| run | " + " | ".join(titles) + " | within 1 cm and 2 deg | median error |",
+             "|---|" + "---|" * (len(kinds) + 2)]
+    for label, rows in results.items():
+        counted = rows.get("heldout", next(iter(rows.values()))).get("seeds", seeds)
+        partial = f" ({counted} of {seeds} seeds)" if counted != seeds else ""
+        cells = [_cell(rows[k]["success_rate"], 100, "%") if k in rows else "-" for k in kinds]
+        fixed = rows.get("heldout")
+        cells += [_cell(fixed["precise_success_rate"], 100, "%"),
+                  f"{fixed['position_error_median']['mean'] * 100:.2f} cm, "
+                  f"{fixed['attitude_error_median']['mean']:.2f} deg"] if fixed else ["-", "-"]
+        lines.append(f"| {RUNS.get(label, label)}{partial} | " + " | ".join(cells) + " |")
+    return lines
+
+
 def render_readme_table(record: dict) -> str:
     lines = [README_BEGIN.format(name=record["name"]),
-             f"`{record['command']}` ({record['date']}, {record['machine']}), mean [min, max] over seeds "
+             f"`{record['command']}` ({record['date']}), mean [min, max] over seeds "
              f"{', '.join(map(str, record['seeds']['seeds']))}; control steps per run: {budget(record)}:", ""]
-    lines += seeds_table(record)
+    lines += short_table(record)
     lines += ["", README_END]
     return "\n".join(lines)
 
