@@ -79,6 +79,12 @@ def _cell(stats: dict, scale: float, unit: str, digits: int = 1) -> str:
     return f"{mean} {unit}" if low == high else f"{mean} {unit} [{low}, {high}]"
 
 
+def partial_seeds(row: dict, seeds: int) -> str:
+    """' (k of n seeds)' for a row evaluated on fewer seeds than its record has, else ''."""
+    counted = row.get("seeds", seeds)
+    return f" ({counted} of {seeds} seeds)" if counted != seeds else ""
+
+
 def seeds_table(record: dict) -> list:
     """Markdown rows: every run and evaluation, mean [min, max] over the seeds."""
     lines = ["| run | evaluation | success | within 1 cm and 2 deg | median position error | median attitude error |",
@@ -86,8 +92,7 @@ def seeds_table(record: dict) -> list:
     seeds = len(record["seeds"]["seeds"])
     for label, kinds in record["seeds"]["results"].items():
         for kind, row in kinds.items():
-            partial = f" ({row['seeds']} of {seeds} seeds)" if row.get("seeds", seeds) != seeds else ""
-            lines.append(f"| {RUNS.get(label, label)} | {kind_title(kind)}{partial} | "
+            lines.append(f"| {RUNS.get(label, label)} | {kind_title(kind)}{partial_seeds(row, seeds)} | "
                          f"{_cell(row['success_rate'], 100, '%')} | {_cell(row['precise_success_rate'], 100, '%')} | "
                          f"{_cell(row['position_error_median'], 100, 'cm', 2)} | "
                          f"{_cell(row['attitude_error_median'], 1, 'deg', 2)} |")
@@ -157,8 +162,7 @@ def short_table(record: dict) -> list:
     lines = ["| run | " + " | ".join(titles) + " | within 1 cm and 2 deg | median error |",
              "|---|" + "---|" * (len(kinds) + 2)]
     for label, rows in results.items():
-        counted = rows.get("heldout", next(iter(rows.values()))).get("seeds", seeds)
-        partial = f" ({counted} of {seeds} seeds)" if counted != seeds else ""
+        partial = partial_seeds(rows.get("heldout", next(iter(rows.values()))), seeds)
         cells = [_cell(rows[k]["success_rate"], 100, "%") if k in rows else "-" for k in kinds]
         fixed = rows.get("heldout")
         cells += [_cell(fixed["precise_success_rate"], 100, "%"),

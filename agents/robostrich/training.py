@@ -181,13 +181,8 @@ def _json_object(text: str) -> dict:
     return value
 
 
-def build_parser():
-    p = cli_lib.Parser(description="Train curriculum SAC (and a plain-SAC baseline) on the Robostrich arm.")
-    run = p.add_argument_group("what to train")
-    files = p.add_argument_group("run directory and checkpoints")
-    report = p.add_argument_group("evaluation and outputs")
-    files.add_argument("--out", default="runs/default", help="run directory (default: %(default)s)")
-    files.add_argument("--resume", action="store_true", help="continue from the checkpoints in --out")
+def _add_run_arguments(run) -> None:
+    """robostrich-train's flags for what to train: domain, plan, seed, layout, start, workers."""
     run.add_argument("--domain", default="robostrich",
                      help="robostrich (the arm on its frame), robostrich_a1 (on the quadruped) or a dm_control "
                           "domain (default: %(default)s)")
@@ -224,13 +219,27 @@ def build_parser():
                           "\"target_sampling\": \"uniform\", "
                           "\"fixed_stored_starts\": 0}' gives the paper's eq. 10, its uniform draw of targets and "
                           "its fixed starts in lessons 1-2)")
+    run.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
+                     help="also train plain SAC on the final lesson with the same total budget")
+    run.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS),
+                     default=min(2, os.cpu_count() or 1),
+                     help="runs trained at once, one process each (default: %(default)s; the curriculum and "
+                          "the plain-SAC baseline are independent)")
+
+
+def _add_file_arguments(files) -> None:
+    """robostrich-train's flags for the run directory and its checkpoints."""
+    files.add_argument("--out", default="runs/default", help="run directory (default: %(default)s)")
+    files.add_argument("--resume", action="store_true", help="continue from the checkpoints in --out")
     files.add_argument("--keep-lesson-checkpoints", action="store_true",
                        help="also keep a checkpoint after every lesson but the last (RUN/after_lessonK.pkl), "
                             "e.g. the lesson-3 policy to compare lesson 4 with (robostrich-stabilize --reference)")
     files.add_argument("--checkpoint-every", type=positive_int, default=25_000,
                        help="environment steps between checkpoints (default: %(default)s)")
-    run.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
-                     help="also train plain SAC on the final lesson with the same total budget")
+
+
+def _add_report_arguments(report) -> None:
+    """robostrich-train's flags for the evaluations and what is written."""
     report.add_argument("--eval-every", type=positive_int, default=None,
                         help="environment steps between held-out evaluations (default: steps/6)")
     report.add_argument("--num-eval-targets", type=evaluation.target_count, default=20,
@@ -245,10 +254,13 @@ def build_parser():
     report.add_argument("--no-rerun", action="store_true", help="no .rrd recordings of the final evaluation")
     report.add_argument("--no-figures", action="store_true", help="no PNG figures")
     report.add_argument("--quiet", action="store_true", help="no progress bar")
-    run.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS),
-                     default=min(2, os.cpu_count() or 1),
-                     help="runs trained at once, one process each (default: %(default)s; the curriculum and "
-                          "the plain-SAC baseline are independent)")
+
+
+def build_parser():
+    p = cli_lib.Parser(description="Train curriculum SAC (and a plain-SAC baseline) on the Robostrich arm.")
+    _add_run_arguments(p.add_argument_group("what to train"))
+    _add_file_arguments(p.add_argument_group("run directory and checkpoints"))
+    _add_report_arguments(p.add_argument_group("evaluation and outputs"))
     p.add_argument("--stop-at-step", type=positive_int, default=None, help=argparse.SUPPRESS)  # imitates a kill (tests)
     add_agent_arguments(p)
     return p

@@ -78,7 +78,6 @@ class SACConfig:
     # plain EMA.  From 100k updates on the rate is policy_average itself.
     policy_average_fraction: float = 0.1
 
-
     # One line per field: what it sets (a training command's --help shows it beside the flag).
     HELP: ClassVar[dict] = {
         "batch_size": "transitions per gradient step",

@@ -144,7 +144,8 @@ def main(argv=None) -> None:
     parser.add_argument("--blue-samples", type=cli_lib.whole_number(0), default=0,
                         help="kinematic samples whose level heads (the blue region) each get a sought "
                              "pose (default: %(default)s)")
-    parser.add_argument("--seed", type=cli_lib.seed, default=0, help="random seed of the held inputs and samples (default: %(default)s)")
+    parser.add_argument("--seed", type=cli_lib.seed, default=0,
+                        help="random seed of the held inputs and samples (default: %(default)s)")
     parser.add_argument("--out", type=pathlib.Path, required=True,
                         help="target file to write (the shipped one: robostrich_suite/data/level_head_poses.npz)")
     parser.add_argument("--seek-level-time", type=cli_lib.seconds(allow_zero=True), default=SEEK_LEVEL_TIME,

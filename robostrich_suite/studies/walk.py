@@ -143,7 +143,8 @@ def main(argv=None) -> None:
                         help="output directory: writes OUT/walk.rrd and OUT/walk.png "
                              "(default: %(default)s)")
     parser.add_argument("--no-rrd", action="store_true", help="skip the Rerun recording")
-    parser.add_argument("--seed", type=cli_lib.seed, default=0, help="random seed of the episode (default: %(default)s)")
+    parser.add_argument("--seed", type=cli_lib.seed, default=0,
+                        help="random seed of the episode (default: %(default)s)")
     args = parser.parse_args(argv)
     problem = out_directory_problem(args.out)
     if problem:
