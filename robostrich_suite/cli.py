@@ -11,6 +11,7 @@ point in setup.py, which calls `run(main, prog, argv)`:
     130  interrupted (Ctrl-C), also when a library swallowed the KeyboardInterrupt; a long
          loop that polls `interrupted()` inside `deferred_interrupts()` stops where its
          state is whole (training writes a checkpoint first)
+    143  terminated (SIGTERM, as a batch scheduler or `kill` sends): handled as Ctrl-C is
 
 Usage errors (`Parser`) are one line too, exit status 2; `--help` exits 0.  Anything
 else is a bug and keeps its traceback.
@@ -29,7 +30,9 @@ import threading
 from typing import Callable, Optional, Sequence
 
 USER_ERROR = 2
-INTERRUPTED = 130
+INTERRUPTED = 130  # 128 + SIGINT
+TERMINATED = 143  # 128 + SIGTERM
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)  # both stop a command the same way (module doc)
 CHECKPOINT_WRITTEN = "checkpoint written"  # how an interrupt that saved its work begins its message
 
 # Generous but finite limits of what a flag may ask for.
@@ -39,6 +42,7 @@ MAX_WORKERS = 256  # processes
 MAX_SEED = 2**31 - 1 - 100_000  # seeds with offsets added stay 32-bit
 
 _interrupted = False
+_signal = signal.SIGINT  # the stop signal that came last
 _deferred = 0
 
 
@@ -63,10 +67,20 @@ def raise_if_interrupted() -> None:
 
 
 def _on_sigint(signum, frame):
-    global _interrupted
-    _interrupted = True
+    """Ctrl-C or SIGTERM: a KeyboardInterrupt now, or a flag for the loop inside `deferred_interrupts`."""
+    global _interrupted, _signal
+    _interrupted, _signal = True, signum
     if not _deferred:
         raise KeyboardInterrupt
+
+
+def _install(handler) -> dict:
+    """Set `handler` for both stop signals; returns the handlers it replaced."""
+    previous = {}
+    for signum in STOP_SIGNALS:
+        previous[signum] = signal.getsignal(signum)
+        signal.signal(signum, handler if not isinstance(handler, dict) else handler[signum])
+    return previous
 
 
 @contextlib.contextmanager
@@ -76,16 +90,15 @@ def deferred_interrupts():
     half-made state behind."""
     global _deferred, _interrupted
     main_thread = threading.current_thread() is threading.main_thread()
-    previous = signal.getsignal(signal.SIGINT) if main_thread else _on_sigint
-    if previous is not _on_sigint:
-        signal.signal(signal.SIGINT, _on_sigint)
+    inside_run = not main_thread or signal.getsignal(signal.SIGINT) is _on_sigint
+    previous = None if inside_run else _install(_on_sigint)
     _deferred += 1
     try:
         yield
     finally:
         _deferred -= 1
-        if previous is not _on_sigint:  # outside `run` (a Python caller): the loop has acted on it
-            signal.signal(signal.SIGINT, previous)
+        if previous is not None:  # outside `run` (a Python caller): the loop has acted on it
+            _install(previous)
             _interrupted = False
 
 
@@ -105,22 +118,27 @@ def run(main: Callable, prog: str, argv: Optional[Sequence[str]] = None) -> int:
     global _interrupted, _deferred
     _interrupted, _deferred = False, 0
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, _on_sigint)
+        _install(_on_sigint)
     try:
         main(argv)
-        status, detail = (INTERRUPTED if _interrupted else 0), ""  # a library swallowed the KeyboardInterrupt
+        status, detail = (_stop_status() if _interrupted else 0), ""  # a library swallowed the KeyboardInterrupt
     except KeyboardInterrupt as error:  # the one detail worth a word: where a checkpoint went (a
         # library may wrap the interrupt in its own context, which says nothing to the user)
-        status, detail = INTERRUPTED, error_message(error) if str(error).startswith(CHECKPOINT_WRITTEN) else ""
+        status, detail = _stop_status(), error_message(error) if str(error).startswith(CHECKPOINT_WRITTEN) else ""
     except (ValueError, OSError) as error:
         sys.stdout.flush()
         print(f"{prog}: error: {error_message(error)}", file=sys.stderr)
         return USER_ERROR
     finally:
         _deferred += 1
-    if status == INTERRUPTED:
-        print(f"{prog}: interrupted" + (f" ({detail})" if detail else ""), file=sys.stderr)
+    if status in (INTERRUPTED, TERMINATED):
+        print(f"{prog}: {'terminated' if status == TERMINATED else 'interrupted'}" + (f" ({detail})" if detail else ""),
+              file=sys.stderr)
     return status
+
+
+def _stop_status() -> int:
+    return TERMINATED if _signal == signal.SIGTERM else INTERRUPTED
 
 
 def _number(kind, text: str):

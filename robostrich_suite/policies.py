@@ -109,6 +109,8 @@ def read_policy(path) -> Policy:
     the version this code reads."""
     path = pathlib.Path(path)
     try:
+        if not zipfile.is_zipfile(path):  # numpy would read anything else as a pickle it then refuses
+            raise ValueError(f"{path}: not a policy file (not an .npz archive{', it is empty' if path.stat().st_size == 0 else ''})")
         with np.load(path, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
             version = meta.get("format_version")
@@ -123,7 +125,7 @@ def read_policy(path) -> Policy:
                           fingerprint=str(meta["fingerprint"]), info=dict(meta.get("info", {})))
     except FileNotFoundError:
         raise ValueError(f"{path}: no such policy file") from None
-    except (KeyError, OSError, zipfile.BadZipFile, json.JSONDecodeError, TypeError, AttributeError) as error:
+    except (KeyError, OSError, EOFError, zipfile.BadZipFile, json.JSONDecodeError, TypeError, AttributeError) as error:
         raise ValueError(f"{path}: not a policy file ({type(error).__name__}: {error})") from None
 
 

@@ -5,20 +5,25 @@ is logged each step; its geoms are static children in the body frame
 (capsules, boxes, spheres, cylinders as capsules, planes as thin boxes).  One
 piece of code serves the arm on its frame and the arm on the quadruped.
 
-    rec = rerun_log.recording("robostrich", "out/rollout.rrd")
-    rerun_log.log_geometry(rec, physics)
-    for t in ...:
-        rerun_log.set_sim_time(rec, physics.data.time)
-        rerun_log.log_body_poses(rec, physics)
-    rec.flush()
+    with rerun_log.recording("robostrich", "out/rollout.rrd") as rec:
+        rerun_log.log_geometry(rec, physics)
+        for t in ...:
+            rerun_log.set_sim_time(rec, physics.data.time)
+            rerun_log.log_body_poses(rec, physics)
+
+A recording streams into a temporary file beside its path and takes the path's name only once
+it is whole (``RecordingFile``): an error or Ctrl-C mid-rollout leaves no half-written ``.rrd``.
 
 Time is on the ``sim_time`` timeline (seconds).  Rerun quaternions are xyzw;
 MuJoCo's are wxyz.
 """
 from __future__ import annotations
 
+import contextlib
+import os
 import pathlib
 import re
+import tempfile
 
 import mujoco
 import numpy as np
@@ -27,13 +32,42 @@ import rerun as rr
 SIM_TIME = "sim_time"
 
 
-def recording(app_id: str, path: str | pathlib.Path) -> rr.RecordingStream:
-    """A recording stream that writes to ``path`` (an ``.rrd`` file)."""
-    path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    rec = rr.RecordingStream(app_id)
-    rec.save(str(path))
-    return rec
+class RecordingFile:
+    """A recording stream saved to a temporary file beside ``path``: ``close()`` renames it over
+    ``path`` once whole, ``discard()`` removes it (``path`` keeps what it held)."""
+
+    def __init__(self, app_id: str, path: str | pathlib.Path, recording_id: str | None = None):
+        self.path = pathlib.Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd, self.partial = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".partial", dir=self.path.parent)
+        os.close(fd)
+        self.stream = rr.RecordingStream(app_id, recording_id=recording_id)
+        self.stream.save(self.partial)
+
+    def close(self) -> pathlib.Path:
+        self.stream.flush()
+        self.stream.disconnect()
+        os.chmod(self.partial, 0o644)
+        os.replace(self.partial, self.path)
+        return self.path
+
+    def discard(self) -> None:
+        self.stream.disconnect()
+        if os.path.exists(self.partial):
+            os.unlink(self.partial)
+
+
+@contextlib.contextmanager
+def recording(app_id: str, path: str | pathlib.Path, recording_id: str | None = None):
+    """A recording stream for the block, written to ``path`` (an ``.rrd`` file) when the block
+    ends without an error, and to no file otherwise (``RecordingFile``)."""
+    file = RecordingFile(app_id, path, recording_id)
+    try:
+        yield file.stream
+    except BaseException:
+        file.discard()
+        raise
+    file.close()
 
 
 def set_sim_time(rec: rr.RecordingStream, seconds: float) -> None:

@@ -32,3 +32,25 @@ def test_figures_and_text_land_whole_with_ordinary_permissions(tmp_path):
     files.write_text(tmp_path / "table.md", "| a |\n")
     assert (tmp_path / "table.md").read_text() == "| a |\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["sub", "table.md"]
+
+
+def test_a_write_that_cannot_land_names_the_path_asked_for_not_the_temporary_file(tmp_path):
+    directory = tmp_path / "a_directory"
+    directory.mkdir()
+    with pytest.raises(IsADirectoryError) as caught:
+        files.write_text(directory, "text")
+    assert caught.value.filename == str(directory)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_directory"]  # no partial file left
+
+
+def test_a_recording_is_written_whole_or_not_at_all(tmp_path):
+    from robostrich_suite import rerun_log
+    path = tmp_path / "rollout.rrd"
+    with pytest.raises(KeyboardInterrupt):
+        with rerun_log.recording("test", path) as rec:
+            rerun_log.log_scalars(rec, "plots", {"x": 1.0})
+            raise KeyboardInterrupt
+    assert list(tmp_path.iterdir()) == []
+    with rerun_log.recording("test", path) as rec:
+        rerun_log.log_scalars(rec, "plots", {"x": 1.0})
+    assert [p.name for p in tmp_path.iterdir()] == ["rollout.rrd"] and path.stat().st_size > 0

@@ -205,16 +205,37 @@ def test_torn_and_damaged_metrics_lines(tmp_path):
 
 
 def test_ctrl_c_stops_a_long_command_with_130_and_nothing_half_written(tmp_path):
-    out = tmp_path / "stabilize"
-    process = start("robostrich-stabilize", "--seeds", "200", "--no-progress", "--no-rerun", "--no-figures",
-                    "--out", out)
-    wait_for(lambda: out.exists() or process.poll() is not None, "the first rollout")
+    """Stopped while they stream a Rerun recording, the commands leave no .rrd (nor its partial file)."""
+    commands = {"stabilize": ("robostrich-stabilize", "--seeds", "200", "--no-progress", "--no-figures"),
+                "walk": ("robostrich-walk", "--seconds", "300")}
+    processes = {name: start(*command, "--out", tmp_path / name) for name, command in commands.items()}
+    for name, process in processes.items():
+        out = tmp_path / name
+        wait_for(lambda: (out.exists() and any(out.iterdir())) or process.poll() is not None, "the recording")
     time.sleep(1.0)
-    process.send_signal(signal.SIGINT)
+    for name, process in processes.items():
+        process.send_signal(signal.SIGINT)
+        result = finish(process)
+        assert result.returncode == 130, result.stderr[-3000:]
+        assert result.stderr.strip().splitlines()[-1] == f"robostrich-{name}: interrupted", result.stderr
+        assert os.listdir(tmp_path / name) == []  # no report, no half-written recording
+
+
+def test_sigterm_is_handled_as_ctrl_c_checkpoint_written_and_143(tmp_path):
+    """A batch scheduler stops a job with SIGTERM: training writes its checkpoint and exits 143 with one line."""
+    out = tmp_path / "run"
+    train = [("lesson1:2900,lesson2:2900" if a == "lesson1:300,lesson2:300" else a) for a in TRAIN]
+    process = start("robostrich-train", *train, "--no-baseline", "--out", out)
+    metrics = out / "curriculum" / "metrics.jsonl"
+    wait_for(lambda: process.poll() is not None or (metrics.exists() and metrics.stat().st_size > 0),
+             "the first episode")
+    process.send_signal(signal.SIGTERM)
     result = finish(process)
-    assert result.returncode == 130, result.stderr[-3000:]
-    assert result.stderr.strip().splitlines() == ["robostrich-stabilize: interrupted"], result.stderr
-    assert os.listdir(out) == []  # no report, no half-written file
+    assert result.returncode == 143, result.stderr[-3000:]
+    line = result.stderr.strip().splitlines()[-1]
+    assert line.startswith("robostrich-train: terminated (checkpoint written at step"), result.stderr[-3000:]
+    steps = checkpoint._read_record(str(out / "curriculum" / "checkpoint.pkl"))["payload"]["loop"]["env_steps"]
+    assert 0 < steps < 5800
 
 
 def test_ctrl_c_while_a_command_still_imports_its_libraries_is_one_line_and_130(tmp_path):

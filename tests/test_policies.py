@@ -46,6 +46,12 @@ def test_policy_file_errors_name_the_file(tmp_path):
     np.savez(bad, something=np.zeros(3))
     with pytest.raises(ValueError, match="bad.npz: not a policy file"):
         policies.load_policy(str(bad))
+    (tmp_path / "empty.npz").write_bytes(b"")
+    with pytest.raises(ValueError, match="empty.npz: not a policy file .not an .npz archive, it is empty"):
+        policies.load_policy(str(tmp_path / "empty.npz"))
+    (tmp_path / "text.npz").write_text("not a policy at all\n")
+    with pytest.raises(ValueError, match="text.npz: not a policy file .not an .npz archive"):
+        policies.load_policy(str(tmp_path / "text.npz"))
     with pytest.raises(ValueError, match="no such policy file"):
         policies.load_policy(str(tmp_path / "missing.npz"))
     with pytest.raises(ValueError, match="unknown policy 'nope'"):

@@ -157,25 +157,14 @@ def rollouts(policy: Policy, task: str, seeds: int, gait, record_for: Callable,
     """`policy` on `task` over `seeds` gait phases: yields (seed, environment, series) per phase.
     `record_for(env)` gives :func:`rollout`'s per-step `record`; the phase-0 rollout is recorded
     to `recording` (a .rrd path; None: no recording)."""
+    from agents.robostrich.recording import open_recorder
     for seed in range(seeds):
         env = make_environment(policy.domain, task, seed, seeds, gait, **task_kwargs)
-        recorder = open_recorder(recording, f"{task} {policy.label}") if seed == 0 else None
-        try:
+        with open_recorder(recording if seed == 0 else None, f"{task} {policy.label}") as recorder:
             series = rollout(env, policy, record_for(env), recorder)
-        finally:
-            if recorder is not None:
-                recorder.close()
         yield seed, env, series
         if bar is not None:
             bar.update(1)
-
-
-def open_recorder(path: Optional[str], name: str):
-    """A Rerun recorder writing `path` (agents/robostrich/recording.py), or None for no recording."""
-    if path is None:
-        return None
-    from agents.robostrich.recording import RolloutRecorder
-    return RolloutRecorder(path, name=name)
 
 
 def progress(total: int, desc: str, enabled: bool = True):

@@ -3,14 +3,16 @@
 A console script imports its module before anything can handle an interrupt; ours pull in MuJoCo,
 JAX and matplotlib, which takes seconds. Each entry here imports its command's module with Ctrl-C
 noted, so Ctrl-C while that happens ends the command as Ctrl-C anywhere else does: one line
-``PROG: interrupted`` and exit status 130 (robostrich_suite/cli.py), not Python's traceback.
+``PROG: interrupted`` and exit status 130 (robostrich_suite/cli.py), not Python's traceback; SIGTERM
+likewise (``PROG: terminated``, 143).
 Importing this module loads nothing heavy (tests/test_hostile_input.py checks).
 """
 import importlib
 import signal
 import sys
 
-INTERRUPTED = 130  # as robostrich_suite.cli.INTERRUPTED, which this module must not import
+INTERRUPTED = 130  # as robostrich_suite.cli.INTERRUPTED and TERMINATED, which this module must not import
+TERMINATED = 143
 
 COMMANDS = {
     "robostrich-train": "agents.robostrich.training:cli",
@@ -35,14 +37,17 @@ def launch(prog: str) -> int:
     done, before it starts any work."""
     module, function = COMMANDS[prog].split(":")
     interrupted = []
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: interrupted.append(signum))
+    previous = {signum: signal.signal(signum, lambda signum, frame: interrupted.append(signum))
+                for signum in (signal.SIGINT, signal.SIGTERM)}
     try:
         cli = getattr(importlib.import_module(module), function)
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
     if interrupted:
-        print(f"{prog}: interrupted", file=sys.stderr)
-        return INTERRUPTED
+        terminated = interrupted[-1] == signal.SIGTERM
+        print(f"{prog}: {'terminated' if terminated else 'interrupted'}", file=sys.stderr)
+        return TERMINATED if terminated else INTERRUPTED
     return cli()
 
 

@@ -237,16 +237,11 @@ def evaluate_agent(actor, flattener, out_dir: str, label: str, domain, heldout_t
         reports["heldout_moving"] = evaluate_heldout_moving(actor, flattener, domain, num_targets,
                                                             action_repeat=action_repeat)
     if track_task:
-        recorder = None
-        if record:
-            from agents.robostrich.recording import RolloutRecorder
-            recorder = RolloutRecorder(os.path.join(out_dir, f"{label}_track.rrd"), name=f"{label} track")
-        try:
+        from agents.robostrich.recording import open_recorder
+        with open_recorder(os.path.join(out_dir, f"{label}_track.rrd") if record else None,
+                           f"{label} track") as recorder:
             reports["track"] = evaluate_track(actor, flattener, domain, track_task, recorder=recorder,
                                               action_repeat=action_repeat)
-        finally:
-            if recorder is not None:
-                recorder.close()
     for kind, report in reports.items():
         report.update(label=label, env_steps=env_steps)
         write_json(os.path.join(out_dir, f"{label}_{kind}.json"), report)

@@ -8,7 +8,7 @@ import os
 
 from agents.robostrich import evaluation, figures
 from agents.robostrich.domains import TRACK_TASK, as_domain
-from agents.robostrich.recording import RolloutRecorder
+from agents.robostrich.recording import open_recorder
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import policies
 
@@ -41,13 +41,9 @@ def main(argv=None) -> dict:
     env.close()
     os.makedirs(args.out, exist_ok=True)
     reports = {"heldout": evaluation.evaluate_heldout(policy, policy.flatten, domain, heldout_task, args.num_targets)}
-    recorder = None if args.no_rerun else RolloutRecorder(os.path.join(args.out, f"{LABEL}_track.rrd"),
-                                                         name=f"{LABEL} track")
-    try:
+    with open_recorder(None if args.no_rerun else os.path.join(args.out, f"{LABEL}_track.rrd"),
+                       f"{LABEL} track") as recorder:
         reports["track"] = evaluation.evaluate_track(policy, policy.flatten, domain, TRACK_TASK, recorder=recorder)
-    finally:
-        if recorder is not None:
-            recorder.close()
     for kind, report in reports.items():
         report.update(label=LABEL, policy=args.policy)
         evaluation.write_json(os.path.join(args.out, f"{LABEL}_{kind}.json"), report)

@@ -4,7 +4,8 @@ The arm itself is drawn by `robostrich_suite.rerun_log` (its geoms as 3D
 shapes, body poses per step); other dm_control domains fall back to their
 body positions as a line strip (development only).
 """
-from typing import Dict, List
+import contextlib
+from typing import Dict, List, Optional
 
 import numpy as np
 import rerun as rr
@@ -26,12 +27,14 @@ def _target_in_world(env) -> list:
 
 
 class RolloutRecorder:
-    """Streams one rollout to an .rrd file on a `sim_time` timeline."""
+    """Streams one rollout to an .rrd file on a `sim_time` timeline: `close()` once the rollout is
+    whole writes `path`, `discard()` after an error or Ctrl-C leaves no half-written recording."""
 
     def __init__(self, path: str, name: str = "rollout", application_id: str = "robostrich"):
+        from robostrich_suite import rerun_log
         self.path = path
-        self.rec = rr.RecordingStream(application_id, recording_id=name)
-        self.rec.save(path)
+        self.file = rerun_log.RecordingFile(application_id, path, recording_id=name)
+        self.rec = self.file.stream
         self.head_path: List[list] = []
         self.targets: List[list] = []
         self.step = 0
@@ -81,8 +84,24 @@ class RolloutRecorder:
             self.rec.log("world/all_targets", rr.Points3D(self.targets, radii=0.01, colors=[[230, 40, 40]],
                                                           labels=[f"target {i + 1}" for i in range(len(self.targets))]),
                          static=True)
-        self.rec.flush()
-        self.rec.disconnect()
+        self.file.close()
+
+    def discard(self):
+        self.file.discard()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, error_type, error, traceback):
+        """The recording is written if the block ran to its end, discarded otherwise."""
+        self.close() if error_type is None else self.discard()
+
+
+def open_recorder(path: Optional[str], name: str):
+    """A RolloutRecorder writing `path` for a `with` block, or (path None) a block with no recorder."""
+    if path is None:
+        return contextlib.nullcontext()
+    return RolloutRecorder(path, name=name)
 
 
 CURVE_FIELDS = ("return", "success", "position_error", "attitude_error", "critic_loss", "actor_loss",
@@ -91,8 +110,12 @@ CURVE_FIELDS = ("return", "success", "position_error", "attitude_error", "critic
 
 def log_training_curves(path: str, runs: Dict[str, List[dict]], evals: Dict[str, List[dict]] = None):
     """Training curves of each run on an `env_steps` timeline (one .rrd, one entity per run and field)."""
-    rec = rr.RecordingStream("robostrich", recording_id="training")
-    rec.save(path)
+    from robostrich_suite import rerun_log
+    with rerun_log.recording("robostrich", path, recording_id="training") as rec:
+        _log_curves(rec, runs, evals or {})
+
+
+def _log_curves(rec, runs: Dict[str, List[dict]], evals: Dict[str, List[dict]]):
     for label, records in runs.items():
         if not records:
             continue
@@ -103,7 +126,7 @@ def log_training_curves(path: str, runs: Dict[str, List[dict]], evals: Dict[str,
             if keep.any():
                 rec.send_columns(f"training/{field}/{label}", indexes=[rr.TimeColumn("env_steps", sequence=steps[keep])],
                                  columns=rr.Scalars.columns(scalars=values[keep]))
-    for label, records in (evals or {}).items():
+    for label, records in evals.items():
         if not records:
             continue
         steps = np.array([r["env_steps"] for r in records], np.int64)
@@ -113,5 +136,3 @@ def log_training_curves(path: str, runs: Dict[str, List[dict]], evals: Dict[str,
             values = np.array([r["summary"][field] for r in records], np.float64)
             rec.send_columns(f"heldout/{field}/{label}", indexes=[rr.TimeColumn("env_steps", sequence=steps)],
                              columns=rr.Scalars.columns(scalars=values))
-    rec.flush()
-    rec.disconnect()

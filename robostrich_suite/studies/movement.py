@@ -448,14 +448,13 @@ def run_patterns(args, base: MovementConfig, spec) -> tuple[dict, list]:
             amplitude = match_lever_amplitude(config, results["rolling"].head_travel(), spec,
                                               progress=progress)
             config = dataclasses.replace(config, lever_amplitude=amplitude)
-        recording = None
         rrd = args.out / f"{pattern}.rrd"
-        if not args.no_recording:
+        if args.no_recording:
+            movement = run(config, spec, progress=progress)
+        else:
             from robostrich_suite import rerun_log
-            recording = rerun_log.recording(f"robostrich_movement_{pattern}", rrd)
-        movement = run(config, spec, recording=recording, progress=progress)
-        if recording is not None:
-            recording.flush()
+            with rerun_log.recording(f"robostrich_movement_{pattern}", rrd) as recording:
+                movement = run(config, spec, recording=recording, progress=progress)
             written.append(rrd)
         written.append(movement_figure.plot_movement(movement, args.out / f"{pattern}.png"))
         results[pattern] = movement

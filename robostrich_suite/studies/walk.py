@@ -59,14 +59,21 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
     physics = env.physics
     script = scripted_tendons(tendons, physics.arm_control_range(),
                               physics_lib.dorsal_index(physics.model))
-    rec = None
-    if rrd_path is not None:
-        rec = rerun_log.recording("robostrich_a1_walk", pathlib.Path(rrd_path))
+    steps = int(round(seconds / CONTROL_TIMESTEP))
+    if rrd_path is None:
+        return _walk(env, script, steps, None)
+    with rerun_log.recording("robostrich_a1_walk", pathlib.Path(rrd_path)) as rec:
         rerun_log.log_geometry(rec, physics)
+        return _walk(env, script, steps, rec)
+
+
+def _walk(env, script, steps: int, rec) -> dict:
+    """`steps` control steps of `script`'s tendon inputs: the series of record_walk, logged to `rec`."""
+    physics = env.physics
     series = collections.defaultdict(list)
     head_path = []
-    steps = int(round(seconds / CONTROL_TIMESTEP))
     for i in range(steps):
+        cli_lib.raise_if_interrupted()  # a library may have swallowed Ctrl-C's KeyboardInterrupt
         t = env.task.episode_time(physics)
         step = env.step(script(t))
         t = env.task.episode_time(physics)
@@ -95,8 +102,6 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
                 rerun_log.log_path(rec, "world/head_path", head_path)
         if step.last():
             break
-    if rec is not None:
-        rec.flush()
     return {key: np.array(value) for key, value in series.items()}
 
 
