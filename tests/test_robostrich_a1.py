@@ -110,6 +110,32 @@ def test_lesson4_trunk_height_changes_over_the_episode():
     assert heights[: n // 8].mean() == pytest.approx(quad.STANDING_TRUNK_HEIGHT, abs=0.01)
 
 
+def test_lesson4_standing_share_mixes_standing_episodes_into_the_walk():
+    """A standing episode of lesson 4 keeps the quadruped in place at the nominal height; the
+    others trot; the share is drawn per episode from the task's own random stream."""
+    env = robostrich_suite.load("robostrich_a1", "lesson4", task_kwargs=dict(random=5, standing_share=0.5))
+    kinds = []
+    for _ in range(6):
+        env.reset()
+        start = env.physics.trunk_position()
+        vz = []
+        for _ in range(150):
+            env.step(np.zeros(9))
+            vz.append(env.physics.trunk_velocity()[2])
+        walked = env.physics.trunk_position()[0] - start[0]
+        rms = float(np.sqrt(np.mean(np.square(vz))))
+        if env.task.episode_legs == "stand":
+            assert abs(walked) < 0.02 and rms < 0.03
+            assert env.physics.trunk_height() == pytest.approx(quad.STANDING_TRUNK_HEIGHT, abs=0.01)
+        else:
+            assert walked > 0.1 and rms > 0.1
+        kinds.append(env.task.episode_legs)
+    assert set(kinds) == {"stand", "walk"}
+    for share in (-0.1, 1.5, float("nan")):
+        with pytest.raises(ValueError, match="standing_share"):
+            robostrich_suite.load("robostrich_a1", "lesson4", task_kwargs=dict(standing_share=share))
+
+
 def test_trunk_height_can_be_commanded_during_an_episode():
     env = robostrich_suite.load("robostrich_a1", "head_stabilize", task_kwargs=dict(random=0))
     env.reset()

@@ -118,6 +118,7 @@ FRAME_OBSERVATION_SOURCES = {
 FRAME_POSITION_KEYS = ("head_position", "target_position")
 
 
+_STANDING = gait_lib.Standing()
 _LEFT_SIGN = np.array([1.0 if leg.endswith("L") else -1.0 for leg in quad.LEGS])
 
 
@@ -133,6 +134,9 @@ class _QuadrupedTaskMixin:
       trunk_heights: a :class:`gait.TrunkHeightSchedule`, a callable ``random ->
         schedule`` (a new schedule each episode), or ``None`` (constant nominal height).
       steer: keep the walk on the start line (see ``STEER_*``); off = the pure open-loop gait.
+      standing_share: for walking, the chance that an episode stands still at the nominal
+        height instead (the standing lessons rehearsed, so that training to walk does not
+        unlearn them); standing tasks always stand.
     """
 
     # The goal (forward, up) is compared with these components of the 3-D head position
@@ -140,9 +144,11 @@ class _QuadrupedTaskMixin:
     ACHIEVED_COMPONENTS = (0, 2)
 
     def __init__(self, *, legs: str = "stand", gait=None, trunk_heights=None, steer: bool = True,
-                 **kwargs):
+                 standing_share: float = 0.0, **kwargs):
         if legs not in ("stand", "walk"):
             raise ValueError(f"unknown legs {legs!r}; use 'stand' or 'walk'")
+        if not 0.0 <= standing_share <= 1.0:  # also refuses NaN
+            raise ValueError(f"standing_share must be a share in [0, 1], got {standing_share!r}")
         if legs == "walk":
             if gait is None:
                 gait = gait_lib.GaitReplay.from_file()
@@ -156,6 +162,8 @@ class _QuadrupedTaskMixin:
         self.legs = legs
         self.gait = gait
         self.steer = bool(steer)
+        self.standing_share = float(standing_share)
+        self.episode_legs = legs  # "stand" in a walking task's standing episode (standing_share)
         self._trunk_heights = trunk_heights
         self.height_schedule = gait_lib.TrunkHeightSchedule()
         self._episode_start_time = 0.0
@@ -164,9 +172,14 @@ class _QuadrupedTaskMixin:
 
     # Episode.
     def initialize_episode(self, physics):
+        self.episode_legs = self.legs
+        if self.legs == "walk" and self.standing_share > 0.0:  # no draw otherwise: streams as before
+            self.episode_legs = "stand" if self.random.uniform() < self.standing_share else "walk"
         schedule = self._trunk_heights
         if callable(schedule) and not isinstance(schedule, gait_lib.TrunkHeightSchedule):
             schedule = schedule(self.random)
+        if self.episode_legs != self.legs:
+            schedule = None  # a standing episode holds the nominal height
         self.height_schedule = schedule or gait_lib.TrunkHeightSchedule()
         continuing = self.initial_state == "continue" and self._continuing_state(physics) is not None
         if not continuing:
@@ -193,8 +206,10 @@ class _QuadrupedTaskMixin:
 
     def leg_targets(self, physics) -> np.ndarray:
         t = self.episode_time(physics)
-        height = float(self.height_schedule(t)) + legs.SAG_COMPENSATION[self.legs]
-        scale = self.stride_scale(physics) if self.legs == "walk" and self.steer else None
+        height = float(self.height_schedule(t)) + legs.SAG_COMPENSATION[self.episode_legs]
+        if self.episode_legs == "stand":
+            return _STANDING.joint_targets(t, height)
+        scale = self.stride_scale(physics) if self.steer else None
         return self.gait.joint_targets(t, height, scale)
 
     def stride_scale(self, physics) -> np.ndarray:
