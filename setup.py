@@ -27,8 +27,10 @@ setup(
         "tqdm==4.70.1",  # progress bars on training and sampling
     ],
     extras_require={
-        "test": ["pytest==9.2.0", "pytest-xdist==3.8.0", "gymnasium==1.4.0"],
+        # ray: the sweep's tests start a local Ray, and CI installs only this extra
+        "test": ["pytest==9.2.0", "pytest-xdist==3.8.0", "gymnasium==1.4.0", "ray==2.60.0"],
         "gym": ["gymnasium==1.4.0"],
+        "sweep": ["ray==2.60.0"],  # robostrich-sweep: grids of runs as Ray tasks
     },
     entry_points={
         "console_scripts": [
@@ -44,6 +46,7 @@ setup(
             "robostrich-workspace = agents.robostrich.commands:workspace",
             "robostrich-targets = agents.robostrich.commands:targets",
             "robostrich-gait = agents.robostrich.commands:gait",
+            "robostrich-sweep = agents.robostrich.commands:sweep",
         ],
     },
 )

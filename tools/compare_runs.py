@@ -6,8 +6,8 @@
 Each GROUP is ``LABEL=GLOB``: the glob names robostrich-train output directories (one per seed;
 their curriculum/evals.jsonl, config.json and summary.json are read). Writes a PNG (periodic
 held-out success and position error along training, final success per seed, the lookup's level
-dashed) and prints each group's final numbers as tools/benchmark_seeds.py tabulates them (mean
-[min, max] over its seeds).
+dashed) and prints each group's final numbers as agents/robostrich/sweep_table.py tabulates them
+(mean [min, max] over its seeds).
 """
 import argparse
 import glob
@@ -19,8 +19,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-import benchmark_seeds  # noqa: E402  (tools/, beside this script)
-from agents.robostrich import figures  # noqa: E402
+from agents.robostrich import figures, sweep_table  # noqa: E402
 from agents.robostrich.runs import parse_plan  # noqa: E402
 
 KINDS = ("heldout", "heldout_moving")
@@ -37,7 +36,7 @@ def load_run(run_dir: str) -> dict:
         with open(os.path.join(run_dir, "curriculum", "evals.jsonl")) as f:
             evals = [json.loads(line) for line in f if line.strip()]
         return {"seed": int(config["seed"]), "evals": evals, "plan": config["plans"]["curriculum"],
-                "summary": summary, "minutes": benchmark_seeds.seed_minutes(run_dir, summary),
+                "summary": summary, "minutes": sweep_table.run_minutes(run_dir, summary),
                 "final": {k: runs["curriculum"][k] for k in KINDS if k in runs["curriculum"]},
                 "lookup": {k: runs["lookup"][k]["success_rate"] for k in KINDS if k in runs.get("lookup", {})}}
     except (OSError, ValueError, KeyError) as e:
@@ -66,7 +65,7 @@ def main(argv=None):
     figures.plot_seed_groups(groups, args.out, lookup, list(boundaries))
     for label, seeds in groups.items():
         print(f"## {label}\n")
-        print(benchmark_seeds.format_table(benchmark_seeds.aggregate(
+        print(sweep_table.format_table(sweep_table.aggregate(
             [s["summary"] for s in seeds], [s["seed"] for s in seeds], [s["minutes"] for s in seeds])))
     print(f"wrote {args.out}")
 

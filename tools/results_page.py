@@ -1,12 +1,15 @@
 """The results page and the README's results table, generated from committed result records.
 
+    python tools/results_page.py add main_job runs/sweep/sweep.json --group ventral_slips \\
+        --title "The main job on the paper's robot"
     python tools/results_page.py add main_job runs/seeds_main/seeds.json \\
         --title "The main job on the paper's robot" --command "python tools/benchmark_seeds.py --seeds 0,1,2,3"
     python tools/results_page.py            # rewrite docs/results.md and the README's table
     python tools/results_page.py --check    # exit 1 when either differs from the records
 
-A record (docs/results/NAME.json) keeps what a benchmark wrote (tools/benchmark_seeds.py's
-seeds.json), the command that made it, the date and the machine. Numbers are typed nowhere else:
+A record (docs/results/NAME.json) keeps what a benchmark wrote (one group of robostrich-sweep's
+sweep.json, or an earlier tools/benchmark_seeds.py seeds.json), the command that made it, the date
+and the machine. Numbers are typed nowhere else:
 the page and the README's table are rendered from the records, and tests/test_results_page.py
 fails when the committed text differs from what the records give.
 """
@@ -16,6 +19,7 @@ import json
 import os
 import pathlib
 import platform
+import shlex
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -51,11 +55,35 @@ def machine() -> str:
     return f"{os.cpu_count()} cores, {model}"
 
 
-def make_record(name: str, seeds_json: str, title: str, command: str, date: str = None, note: str = "") -> dict:
+def sweep_group(sweep: dict, path: str, group: str = None) -> tuple:
+    """(aggregate, command) of one group of a robostrich-sweep sweep.json: ``group``, or its only one."""
+    groups = sweep["groups"]
+    if group is None and len(groups) != 1:
+        raise ValueError(f"{path} holds groups {', '.join(groups)}: name one with --group")
+    name = group if group is not None else next(iter(groups))
+    if name not in groups:
+        raise ValueError(f"{path} has no group {name!r} (it has {', '.join(groups)})")
+    if groups[name]["aggregate"] is None:
+        raise ValueError(f"{path}: group {name} has no finished run")
+    return groups[name]["aggregate"], shlex.join(sweep["command"])
+
+
+def make_record(name: str, seeds_json: str, title: str, command: str = None, date: str = None, note: str = "",
+                group: str = None) -> dict:
+    """A record of a robostrich-sweep sweep.json (one group; its command unless ``command`` says) or
+    of a tools/benchmark_seeds.py seeds.json of earlier benchmarks."""
     with open(seeds_json) as f:
         aggregate = json.load(f)
-    if "results" not in aggregate or "seeds" not in aggregate:
-        raise ValueError(f"{seeds_json} is not a tools/benchmark_seeds.py seeds.json (no 'results'/'seeds')")
+    if "groups" in aggregate and "command" in aggregate:
+        aggregate, recorded = sweep_group(aggregate, seeds_json, group)
+        command = command or recorded
+    elif "results" not in aggregate or "seeds" not in aggregate:
+        raise ValueError(f"{seeds_json} is not a tools/benchmark_seeds.py seeds.json nor a robostrich-sweep "
+                         "sweep.json (no 'results'/'seeds', no 'groups')")
+    elif group is not None:
+        raise ValueError(f"--group {group}: {seeds_json} is a seeds.json of one group")
+    if not command:
+        raise ValueError(f"{seeds_json} records no command: give --command")
     return {"format": FORMAT, "name": name, "title": title, "command": command,
             "date": date or datetime.date.today().isoformat(), "machine": machine(), "note": note,
             "seeds": aggregate}
@@ -213,18 +241,21 @@ def expected_files(records: list, readme_text: str) -> dict:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="command")
-    add = sub.add_parser("add", help="store a benchmark's seeds.json as a record in docs/results/")
+    add = sub.add_parser("add", help="store a sweep's sweep.json (one group) or a seeds.json as a record in docs/results/")
     add.add_argument("name")
-    add.add_argument("seeds_json")
+    add.add_argument("seeds_json", help="OUT/sweep.json of robostrich-sweep, or an earlier benchmark's seeds.json")
     add.add_argument("--title", required=True)
-    add.add_argument("--command", dest="run_command", required=True, help="the command that produced it")
+    add.add_argument("--group", default=None, help="the sweep's group to record (default: its only one)")
+    add.add_argument("--command", dest="run_command", default=None,
+                     help="the command that produced it (default: the one sweep.json records)")
     add.add_argument("--date", default=None, help="YYYY-MM-DD (default today)")
     add.add_argument("--note", default="", help="one paragraph shown under the title")
     add.add_argument("--order", type=int, default=100, help="position on the page (lower first)")
     p.add_argument("--check", action="store_true", help="exit 1 when the page or the README differs from the records")
     args = p.parse_args(argv)
     if args.command == "add":
-        record = make_record(args.name, args.seeds_json, args.title, args.run_command, args.date, args.note)
+        record = make_record(args.name, args.seeds_json, args.title, args.run_command, args.date, args.note,
+                             args.group)
         record["order"] = args.order
         RECORDS.mkdir(parents=True, exist_ok=True)
         (RECORDS / f"{args.name}.json").write_text(json.dumps(record, indent=1) + "\n")

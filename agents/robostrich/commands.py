@@ -27,6 +27,7 @@ COMMANDS = {
     "robostrich-workspace": "robostrich_suite.studies.workspace:cli",
     "robostrich-targets": "robostrich_suite.studies.target_generation:cli",
     "robostrich-gait": "robostrich_suite.studies.gait_generation:cli",
+    "robostrich-sweep": "agents.robostrich.sweep:cli",
 }
 
 
@@ -71,3 +72,4 @@ movement = _entry("robostrich-movement")
 workspace = _entry("robostrich-workspace")
 targets = _entry("robostrich-targets")
 gait = _entry("robostrich-gait")
+sweep = _entry("robostrich-sweep")
