@@ -246,8 +246,10 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     paper = {"weights": {"position_precision": 0, "attitude_precision": 0}, "target_sampling": "uniform",
              "fixed_stored_starts": 0}
     assert training.resolve_task_kwargs(paper, arm) == paper
-    # the standing quadruped's arm holds the frame's stored poses: the same recipe there
-    assert training.resolve_task_kwargs({}, Domain("robostrich_a1")) == recipe
+    # the standing quadruped's arm holds the frame's stored poses: the same recipe there, and a
+    # quarter of lesson 4's episodes stand
+    assert training.resolve_task_kwargs({}, Domain("robostrich_a1")) == {**recipe, "standing_share": 0.25}
+    assert training.resolve_task_kwargs({"standing_share": 0}, Domain("robostrich_a1"))["standing_share"] == 0
     assert training.resolve_task_kwargs({}, dmc) == {}
     with pytest.raises(ValueError, match="target_entropy_per_action"):
         SACConfig(target_entropy_per_action=float("nan"))
