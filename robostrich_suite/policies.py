@@ -28,7 +28,8 @@ from robostrich_suite import fingerprint as fingerprint_lib
 FORMAT_VERSION = 1
 POLICY_DIR = pathlib.Path(__file__).parent / "data" / "policies"
 # The shipped policies by name (a domain's default robot and task family).
-SHIPPED = {"robostrich": POLICY_DIR / "robostrich_curriculum.npz"}
+SHIPPED = {"robostrich": POLICY_DIR / "robostrich_curriculum.npz",  # the arm on its frame
+           "robostrich_a1": POLICY_DIR / "robostrich_a1_curriculum.npz"}  # on the quadruped, after lesson 4
 
 
 class PolicyMismatch(ValueError):

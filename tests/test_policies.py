@@ -92,3 +92,19 @@ def test_play_runs_the_shipped_policy_as_an_installed_command(tmp_path):
                          capture_output=True, text=True, timeout=300)
     assert bad.returncode == 2 and bad.stderr.strip().count("\n") == 0, bad.stderr
     assert "nope.npz: no such policy file" in bad.stderr
+
+
+def test_play_runs_the_quadrupeds_shipped_policy_on_held_out_targets_and_head_stabilisation(tmp_path):
+    """The arm on the quadruped ships its policy after lesson 4: it holds standing held-out targets and,
+    walking, keeps the head within 1 cm of its height and level; the frame's arm refuses it."""
+    result = subprocess.run([console_script("robostrich-play"), "--policy", "robostrich_a1", "--num-targets", "2",
+                             "--out", "played"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert "heldout  100.0 % reached" in result.stdout, result.stdout
+    stabilize = json.loads((tmp_path / "played" / "policy_head_stabilize.json").read_text())["summary"]
+    assert stabilize["height_rms_error"] < 0.01 and stabilize["attitude_within_fraction"] > 0.9, stabilize
+    assert stabilize["distance_mean_error"] < 0.02 and not stabilize["fell"], stabilize
+    assert (tmp_path / "played" / "policy_stabilize.png").stat().st_size > 10_000
+    assert (tmp_path / "played" / "stabilize_policy.rrd").stat().st_size > 0
+    with pytest.raises(policies.PolicyMismatch):
+        robostrich_suite.load_policy("robostrich_a1", robostrich_suite.load("robostrich", "lesson2"))

@@ -1,8 +1,9 @@
 """`robostrich-play`: a shipped policy at work in a minute, with no training.
 
 Runs a policy file (robostrich_suite.policies; default: the default robot's curriculum
-policy) on the held-out targets from the fixed start and on the `track` task, prints
-its success, and writes the reports, a Rerun recording of `track` and the track figure.
+policy) on the held-out targets from the fixed start, then on the frame's `track` task or, for a
+policy of the arm on the quadruped, on `head_stabilize` (Fig. 9, one gait phase); prints its
+success, and writes the reports, a Rerun recording of the second task and its figure.
 """
 import os
 
@@ -22,9 +23,39 @@ def _line(kind: str, summary: dict) -> str:
             f"{summary['attitude_error_median']:.2f} deg, {summary['episodes']} targets")
 
 
+def _stabilize_line(metrics: dict) -> str:
+    return (f"head_stabilize: height {metrics['height_rms_error'] * 100:.1f} cm RMS, head / trunk vertical "
+            f"velocity {metrics['head_vz_rms_ratio']:.2f}, P_d {metrics['distance_mean_error'] * 100:.1f} cm off, "
+            f"level {metrics['attitude_within_fraction'] * 100:.0f} % of the time")
+
+
+def play_track(policy, domain, args) -> dict:
+    """`track` (Fig. 7): the report; its recording and figure in args.out."""
+    with open_recorder(None if args.no_rerun else os.path.join(args.out, f"{LABEL}_track.rrd"),
+                       f"{LABEL} track") as recorder:
+        report = evaluation.evaluate_track(policy, policy.flatten, domain, TRACK_TASK, recorder=recorder)
+    figures.plot_track({LABEL: report}, os.path.join(args.out, f"{LABEL}_track.png"))
+    print(_line("track", report["summary"]))
+    return report
+
+
+def play_stabilize(policy, domain, args) -> dict:
+    """`head_stabilize` (Fig. 9) over one gait phase: its metrics; recording and figure in args.out."""
+    from agents.robostrich import application_figures, applications, stabilization
+    compared = applications.Policy(LABEL, domain, lambda env, flattener: policy)
+    results = stabilization.evaluate([compared], 1, applications.load_gait(),
+                                     record_dir=None if args.no_rerun else args.out)
+    application_figures.stabilization_figure(results, os.path.join(args.out, f"{LABEL}_stabilize.png"),
+                                             stabilization.SETTLE)
+    metrics = {k: v for k, v in results[LABEL]["seeds"][0].items() if k != "seed"}
+    print(_stabilize_line(metrics))
+    return {"summary": metrics, "goals": results[LABEL]["goals"]}
+
+
 def main(argv=None) -> dict:
-    parser = cli_lib.Parser(description="Run a trained policy on the held-out targets and the track task: "
-                                        "success printed, reports, a .rrd recording and a PNG written.")
+    parser = cli_lib.Parser(description="Run a trained policy on the held-out targets and on track (the arm on "
+                                        "its frame) or head_stabilize (on the quadruped): success printed, "
+                                        "reports, a .rrd recording and a PNG written.")
     parser.add_argument("--policy", default="robostrich",
                         help=f"a shipped policy ({', '.join(policies.SHIPPED)}) or a .npz policy file "
                              "(written by tools/export_policy.py)")
@@ -40,19 +71,17 @@ def main(argv=None) -> dict:
     policy.check(env)
     env.close()
     os.makedirs(args.out, exist_ok=True)
+    print(f"{args.policy} ({domain.describe()}, seed {policy.info.get('seed')}, "
+          f"{policy.info.get('env_steps')} control steps of training)")
     reports = {"heldout": evaluation.evaluate_heldout(policy, policy.flatten, domain, heldout_task, args.num_targets)}
-    with open_recorder(None if args.no_rerun else os.path.join(args.out, f"{LABEL}_track.rrd"),
-                       f"{LABEL} track") as recorder:
-        reports["track"] = evaluation.evaluate_track(policy, policy.flatten, domain, TRACK_TASK, recorder=recorder)
+    print(_line("heldout", reports["heldout"]["summary"]))
+    second = "head_stabilize" if domain.on_quadruped else "track"
+    reports[second] = (play_stabilize if domain.on_quadruped else play_track)(policy, domain, args)
     for kind, report in reports.items():
         report.update(label=LABEL, policy=args.policy)
         evaluation.write_json(os.path.join(args.out, f"{LABEL}_{kind}.json"), report)
-    figures.plot_track({LABEL: reports["track"]}, os.path.join(args.out, f"{LABEL}_track.png"))
-    print(f"{args.policy} ({domain.describe()}, seed {policy.info.get('seed')}, "
-          f"{policy.info.get('env_steps')} control steps of training)")
-    for kind, report in reports.items():
-        print(_line(kind, report["summary"]))
-    print(f"wrote {args.out}/: reports, {LABEL}_track.png" + ("" if args.no_rerun else f", {LABEL}_track.rrd"))
+    recording = "" if args.no_rerun else (f", stabilize_{LABEL}.rrd" if domain.on_quadruped else f", {LABEL}_track.rrd")
+    print(f"wrote {args.out}/: reports, {LABEL}_{'stabilize' if domain.on_quadruped else 'track'}.png{recording}")
     return reports
 
 
