@@ -46,6 +46,10 @@ class GymnasiumEnv(gymnasium.Env):
                              f"got {render_mode!r}")
         if not (isinstance(width, int) and isinstance(height, int) and width > 0 and height > 0):
             raise ValueError(f"width and height must be positive whole numbers of pixels, got {width!r}, {height!r}")
+        visual = dm_environment.physics.model.vis.global_
+        if width > visual.offwidth or height > visual.offheight:  # the model's offscreen framebuffer
+            raise ValueError(f"width x height {width} x {height} exceeds the model's offscreen framebuffer "
+                             f"({visual.offwidth} x {visual.offheight} pixels)")
         self.dm_env = dm_environment
         self.render_mode = render_mode
         self.width, self.height, self.camera = width, height, camera

@@ -93,6 +93,8 @@ def test_rgb_array_render_shows_the_arm_and_check_env_renders():
     assert gym_adapter.make("robostrich", "lesson1").render() is None  # no render mode: gymnasium's warning, None
     with pytest.raises(ValueError, match="render_mode"):
         gym_adapter.make("robostrich", "lesson1", render_mode="human")
+    with pytest.raises(ValueError, match="100000 x 480 exceeds the model's offscreen framebuffer"):
+        gym_adapter.make("robostrich", "lesson1", render_mode="rgb_array", width=100000)
 
 
 def test_every_task_is_registered_with_gymnasium():
