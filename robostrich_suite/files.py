@@ -12,19 +12,30 @@ import tempfile
 def replaced_atomically(path, mode: str = "wb"):
     """Open a temporary file beside ``path`` for writing; when the block ends without an error it
     is renamed over ``path``, otherwise removed (``path`` keeps what it held)."""
-    path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with _naming(path):
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
+    fd, tmp = temporary_beside(path)
     try:
         with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8", "newline": ""})) as handle:
             yield handle
-        os.chmod(tmp, 0o644)  # mkstemp makes it private; this is an ordinary output file
-        with _naming(path):
-            os.replace(tmp, path)
+        land(tmp, path)
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+
+
+def temporary_beside(path) -> tuple:
+    """(descriptor, name) of a new empty file beside ``path`` (its directory made), for what takes
+    ``path``'s name once whole (``land``); for writers that want a file name, not a handle."""
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with _naming(path):
+        return tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
+
+
+def land(tmp: str, path) -> None:
+    """Rename the whole temporary file ``tmp`` (``temporary_beside``) over ``path``."""
+    os.chmod(tmp, 0o644)  # mkstemp makes it private; this is an ordinary output file
+    with _naming(pathlib.Path(path)):
+        os.replace(tmp, path)
 
 
 @contextlib.contextmanager

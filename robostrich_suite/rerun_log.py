@@ -23,11 +23,12 @@ import contextlib
 import os
 import pathlib
 import re
-import tempfile
 
 import mujoco
 import numpy as np
 import rerun as rr
+
+from robostrich_suite import files
 
 SIM_TIME = "sim_time"
 
@@ -38,8 +39,7 @@ class RecordingFile:
 
     def __init__(self, app_id: str, path: str | pathlib.Path, recording_id: str | None = None):
         self.path = pathlib.Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, self.partial = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".partial", dir=self.path.parent)
+        fd, self.partial = files.temporary_beside(self.path)
         os.close(fd)
         self.stream = rr.RecordingStream(app_id, recording_id=recording_id)
         self.stream.save(self.partial)
@@ -47,8 +47,7 @@ class RecordingFile:
     def close(self) -> pathlib.Path:
         self.stream.flush()
         self.stream.disconnect()
-        os.chmod(self.partial, 0o644)
-        os.replace(self.partial, self.path)
+        files.land(self.partial, self.path)
         return self.path
 
     def discard(self) -> None:
