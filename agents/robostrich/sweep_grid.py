@@ -62,10 +62,6 @@ class Run:
         argv = [*self.arguments, "--seed", str(self.seed), "--out", self.run_dir, "--workers", "1", "--quiet"]
         return argv + ["--resume"] if self.has_checkpoint() else argv
 
-    @property
-    def label(self) -> str:
-        return f"{self.group} seed {self.seed}"
-
 
 def read_grid_file(path: str) -> dict:
     """The grid file's tables, every key known (a typo is an error, not an ignored line)."""

@@ -69,11 +69,12 @@ def training_minutes(summaries) -> dict:
     return {label: _stats([_training_minutes(s, label) for s in summaries]) for label in labels}
 
 
-def _cell(stats, scale, fmt):
-    if stats["mean"] is None:
+def _spread(stats, scale, fmt, collapse: bool = True) -> str:
+    """'12.5 % [10.0, 15.0]' (the unit once), or one value where the seeds agree (``collapse``), or '-'."""
+    if not stats or stats["mean"] is None:
         return "-"
     mean, low, high = (fmt.format(stats[k] * scale) for k in ("mean", "min", "max"))
-    return f"{mean} [{low}, {high}]"
+    return mean if collapse and low == high else f"{mean} [{low.split()[0]}, {high.split()[0]}]"
 
 
 def format_table(agg: dict) -> str:
@@ -85,8 +86,8 @@ def format_table(agg: dict) -> str:
     for label, kinds in agg["results"].items():
         for kind, row in kinds.items():
             partial = f" ({row['seeds']}/{n} seeds)" if row["seeds"] != n else ""
-            lines.append(f"| {label} | {kind}{partial} | "
-                         + " | ".join(_cell(row[m], scale, fmt) for m, _, scale, fmt in METRICS) + " |")
+            cells = [_spread(row[m], scale, fmt, collapse=False) for m, _, scale, fmt in METRICS]
+            lines.append(f"| {label} | {kind}{partial} | " + " | ".join(cells) + " |")
     steps = ", ".join(f"{label} {_join(v)}" for label, v in agg["steps"].items() if any(x is not None for x in v))
     minutes = ", ".join(f"seed {s}: {'-' if m is None else f'{m:.1f}'}" for s, m in zip(agg["seeds"], agg["minutes"]))
     lines += ["", f"Environment steps per run: {steps or '-'}", f"Wall-clock minutes per seed: {minutes}"]
@@ -105,14 +106,6 @@ GROUP_COLUMNS = (("success, fixed start", "heldout", "success_rate", 100.0, "{:.
                  ("within 1 cm and 2 deg", "heldout", "precise_success_rate", 100.0, "{:.1f} %"),
                  ("median position error", "heldout", "position_error_median", 100.0, "{:.2f} cm"),
                  ("median attitude error", "heldout", "attitude_error_median", 1.0, "{:.2f} deg"))
-
-
-def _spread(stats, scale, fmt) -> str:
-    """'12.5 % [10.0, 15.0]', or one value where the seeds agree, or '-'."""
-    if not stats or stats["mean"] is None:
-        return "-"
-    mean, low, high = (fmt.format(stats[k] * scale) for k in ("mean", "min", "max"))
-    return mean if low == high else f"{mean} [{low.split()[0]}, {high.split()[0]}]"
 
 
 def group_table(agg: dict, minutes: dict) -> list:
