@@ -29,27 +29,27 @@ def _stabilize_line(metrics: dict) -> str:
             f"level {metrics['attitude_within_fraction'] * 100:.0f} % of the time")
 
 
-def play_track(policy, domain, args) -> dict:
-    """`track` (Fig. 7): the report; its recording and figure in args.out."""
-    with open_recorder(None if args.no_rerun else os.path.join(args.out, f"{LABEL}_track.rrd"),
-                       f"{LABEL} track") as recorder:
+def play_track(policy, domain, args) -> tuple:
+    """`track` (Fig. 7): (its report, the files written in args.out: figure, recording)."""
+    written = [f"{LABEL}_track.png"] + ([] if args.no_rerun else [f"{LABEL}_track.rrd"])
+    with open_recorder(None if args.no_rerun else os.path.join(args.out, written[-1]), f"{LABEL} track") as recorder:
         report = evaluation.evaluate_track(policy, policy.flatten, domain, TRACK_TASK, recorder=recorder)
-    figures.plot_track({LABEL: report}, os.path.join(args.out, f"{LABEL}_track.png"))
+    figures.plot_track({LABEL: report}, os.path.join(args.out, written[0]))
     print(_line("track", report["summary"]))
-    return report
+    return report, written
 
 
-def play_stabilize(policy, domain, args) -> dict:
-    """`head_stabilize` (Fig. 9) over one gait phase: its metrics; recording and figure in args.out."""
+def play_stabilize(policy, domain, args) -> tuple:
+    """`head_stabilize` (Fig. 9) over one gait phase: (its metrics, the files written in args.out)."""
     from agents.robostrich import application_figures, applications, stabilization
     compared = applications.Policy(LABEL, domain, lambda env, flattener: policy)
     results = stabilization.evaluate([compared], 1, applications.load_gait(),
                                      record_dir=None if args.no_rerun else args.out)
-    application_figures.stabilization_figure(results, os.path.join(args.out, f"{LABEL}_stabilize.png"),
-                                             stabilization.SETTLE)
+    written = [f"{LABEL}_stabilize.png"] + ([] if args.no_rerun else [f"stabilize_{LABEL}.rrd"])
+    application_figures.stabilization_figure(results, os.path.join(args.out, written[0]), stabilization.SETTLE)
     metrics = {k: v for k, v in results[LABEL]["seeds"][0].items() if k != "seed"}
     print(_stabilize_line(metrics))
-    return {"summary": metrics, "goals": results[LABEL]["goals"]}
+    return {"summary": metrics, "goals": results[LABEL]["goals"]}, written
 
 
 def main(argv=None) -> dict:
@@ -75,13 +75,12 @@ def main(argv=None) -> dict:
           f"{policy.info.get('env_steps')} control steps of training)")
     reports = {"heldout": evaluation.evaluate_heldout(policy, policy.flatten, domain, heldout_task, args.num_targets)}
     print(_line("heldout", reports["heldout"]["summary"]))
-    second = "head_stabilize" if domain.on_quadruped else "track"
-    reports[second] = (play_stabilize if domain.on_quadruped else play_track)(policy, domain, args)
+    second, play = ("head_stabilize", play_stabilize) if domain.on_quadruped else ("track", play_track)
+    reports[second], written = play(policy, domain, args)
     for kind, report in reports.items():
         report.update(label=LABEL, policy=args.policy)
         evaluation.write_json(os.path.join(args.out, f"{LABEL}_{kind}.json"), report)
-    recording = "" if args.no_rerun else (f", stabilize_{LABEL}.rrd" if domain.on_quadruped else f", {LABEL}_track.rrd")
-    print(f"wrote {args.out}/: reports, {LABEL}_{'stabilize' if domain.on_quadruped else 'track'}.png{recording}")
+    print(f"wrote {args.out}/: reports, {', '.join(written)}")
     return reports
 
 
