@@ -205,8 +205,10 @@ def test_torn_and_damaged_metrics_lines(tmp_path):
 
 
 def test_ctrl_c_stops_a_long_command_with_130_and_nothing_half_written(tmp_path):
-    """Stopped while they stream a Rerun recording, the commands leave no .rrd (nor its partial file)."""
-    commands = {"stabilize": ("robostrich-stabilize", "--seeds", "200", "--no-progress", "--no-figures"),
+    """Stopped while they stream a Rerun recording, the commands leave no .rrd (nor its partial file).
+    The first rollout (the recorded one) lasts 300 s of simulation, so the stop always lands in it."""
+    commands = {"stabilize": ("robostrich-stabilize", "--seeds", "200", "--time-limit", "300", "--no-progress",
+                              "--no-figures"),
                 "walk": ("robostrich-walk", "--seconds", "300")}
     processes = {name: start(*command, "--out", tmp_path / name) for name, command in commands.items()}
     for name, process in processes.items():
