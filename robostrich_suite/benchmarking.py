@@ -1,6 +1,9 @@
-"""Shared timing helpers of the benchmark scripts in ``tools/`` (never used in tests)."""
+"""Shared helpers of the speed benchmarks in ``tools/``: timed loops and the report they write."""
 from __future__ import annotations
 
+import json
+import os
+import shlex
 import time
 
 import numpy as np
@@ -54,3 +57,25 @@ def episode_steps(domain: str, task: str) -> int:
     """Control steps per episode of ``robostrich_suite.load(domain, task)``."""
     env = robostrich_suite.load(domain, task, task_kwargs=dict(random=0))
     return int(env._step_limit)  # dm_control keeps the time limit only as this step count
+
+
+def rate(what: str, value: float, unit: str) -> dict:
+    """One measured speed of a report."""
+    return {"what": what, "value": float(value), "unit": unit}
+
+
+def ratio(what: str, value: float, low: float = None, high: float = None) -> dict:
+    """One ratio against a baseline measured in the same run, with its spread where the benchmark has one."""
+    row = {"what": what, "value": float(value)}
+    if low is not None:
+        row.update(low=float(low), high=float(high))
+    return row
+
+
+def write_report(path, script: str, argv: list, description: str, rates: list, ratios: list) -> None:
+    """A speed benchmark's ``--json`` file: what ``tools/results_page.py add`` records (kind "speed"),
+    with the command that made it."""
+    from robostrich_suite import files
+    command = shlex.join(["python", f"tools/{os.path.basename(script)}", *argv])
+    files.write_text(path, json.dumps({"benchmark": "speed", "command": command, "description": description,
+                                       "rates": rates, "ratios": ratios}, indent=1) + "\n")

@@ -1,7 +1,8 @@
 """Shared test set-up: headless MuJoCo (MUJOCO_GL=egl unless the environment sets it), the
 checked-in models, one way to find an installed console script (``from conftest import
 console_script``), one way to run it as a user would (``start`` / ``finish``, sharing one XLA
-cache per module with the ``shared_jax_cache`` fixture) and one way to check Rerun recordings."""
+cache per module with the ``shared_jax_cache`` fixture) and one way to check Rerun recordings.
+The scripts of ``tools/`` import as modules (``import results_page``)."""
 import os
 import pathlib
 import shutil
@@ -11,6 +12,7 @@ import sys
 import pytest
 
 os.environ.setdefault("MUJOCO_GL", "egl")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent / "tools"))
 
 RERUN_CLI_MISSING = ("the rerun command of rerun-sdk is not installed (neither beside this Python "
                      "nor on PATH): .rrd recordings not verified")

@@ -9,6 +9,7 @@ import tempfile
 
 import numpy as np
 import pytest
+import results_page
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TOOLS = os.path.join(ROOT, "tools")
@@ -107,6 +108,13 @@ def test_benchmark_dmc_end_to_end_on_cartpole(tmp_path, tool_env):
         assert r["action_repeat"] == 8 and r["env_steps"] >= r["eval_step"] and r["updates"] > 0
     assert result["configs"]["cartpole/swingup"]["action_repeat"] == 8
     assert "| cartpole/swingup | 0 | 400 |" in (out / "dmc.md").read_text()
+    record = results_page.make_record("dmc", str(out / "dmc.json"), "On dm_control", date="2026-12-04")
+    assert record["kind"] == "dmc" and record["command"].startswith("python tools/benchmark_dmc.py --tasks ")
+    page = results_page.render_record(record)
+    last = rows[-1]["return_mean"]
+    assert f"| cartpole/swingup | 200 | {rows[0]['return_mean']:.0f} |" in page
+    assert f"**{last:.0f}** [{last:.0f}, {last:.0f}] | ~835 |" not in page  # no published value at 400 steps
+    assert f"**{last:.0f}** [{last:.0f}, {last:.0f}] | - |" in page
 
 
 def test_benchmark_dmc_rejects_unknown_settings_in_one_line():
@@ -132,7 +140,7 @@ def test_input_sensitivity_stored_inputs_hold_their_targets_and_errors_cost_succ
     assert bad.returncode == 2 and "fractions in [0, 1]" in bad.stderr.strip().splitlines()[-1]
 
 
-def test_env_benchmark_resets_its_raw_baseline_like_the_environment(capsys):
+def test_env_benchmark_resets_its_raw_baseline_like_the_environment(capsys, tmp_path):
     """The raw mj_step baseline runs the same episodes as the environment (lesson 2: 250 control
     steps from the fixed start), as does the bare dm_control environment beside them, and the tool
     prints the rates and the median of its rounds' ratios."""
@@ -151,9 +159,18 @@ def test_env_benchmark_resets_its_raw_baseline_like_the_environment(capsys):
     bare = tool.bare_loop(actions)  # the plain dm_control floor runs them too
     bare.run(300)
     np.testing.assert_array_equal(bare.env.physics.data.qpos, raw.data.qpos)
-    tool.main(["--steps", "100", "--rounds", "3"])
-    lines = capsys.readouterr().out.splitlines()
+    report = tmp_path / "speed.json"
+    tool.main(["--steps", "100", "--rounds", "3", "--json", str(report)])
+    lines = capsys.readouterr().out.splitlines()[:-1]  # the last: where the report went
     ratios = {line.split(":")[0].split()[1]: float(line.split(":")[1].split()[0]) for line in lines[-2:]}
     assert lines[0].startswith("raw mj_step") and "median of 3 rounds" in lines[-1]
     # the ratios are printed, not judged: on a busy machine any value can come out
     assert set(ratios) == {"bare/raw", "env/raw"} and all(math.isfinite(r) and r > 0 for r in ratios.values())
+    # its report is a results record: the printed medians, with their quartiles, and the command
+    record = results_page.make_record("speed", str(report), "Speed", date="2026-12-04")
+    assert record["kind"] == "speed" and record["command"].endswith("--rounds 3 --json " + str(report))
+    written = {row["what"]: row for row in record["data"]["ratios"]}
+    env_ratio = written["robostrich/lesson2 / raw mj_step"]
+    assert f"{env_ratio['value']:.3f}" == f"{ratios['env/raw']:.3f}" and env_ratio["low"] <= env_ratio["high"]
+    assert f"| ratio robostrich/lesson2 / raw mj_step | **{env_ratio['value']:.3f}** [" in \
+        results_page.render_record(record)

@@ -11,6 +11,7 @@ from robostrich_suite.model import arm, layouts
 from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite.studies import coverage, layout_compare, workspace
 
+import results_page
 from conftest import console_script
 
 
@@ -192,6 +193,17 @@ def test_the_fidelity_check_prints_the_candidates_table(tmp_path):
     assert float(rows["ventral_slips"]["rolling_lever_ratio"]) < 0.6
     assert float(rows["ventral_from_base"]["rolling_lever_ratio"]) > 1.0
     assert "head travel (mm)" in result.stdout and "| ventral_slips |" in result.stdout
+    # layouts.json is what a results record keeps: the rows, the command, the blue region
+    written = json.loads((out / "layouts.json").read_text())
+    assert written["command"].startswith("robostrich-layouts --out ") and "--candidates" in written["command"]
+    assert [row["layout"] for row in written["rows"]] == list(rows)
+    assert written["blue_region"]["kinematic_samples"] == 2000
+    record = results_page.make_record("fidelity", str(out / "layouts.json"), "Fidelity", date="2026-12-04")
+    assert record["kind"] == "layouts" and record["command"] == written["command"]
+    page = results_page.render_record(record)
+    ratio = float(rows["ventral_slips"]["rolling_lever_ratio"])
+    assert f"| ventral_slips | 1 | 9 |" in page and f"| {ratio:.2f} |" in page
+    assert "target_file" not in json.dumps(record)  # where this run wrote is not a result
 
 
 def run_layouts(*args):

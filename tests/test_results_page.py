@@ -30,21 +30,21 @@ def test_readme_and_results_page_match_the_records():
 def test_every_number_of_the_readme_table_comes_from_the_main_job_record():
     record = {r["name"]: r for r in results_page.read_records()}[results_page.README_RECORD]
     readme = (ROOT / "README.md").read_text()
-    begin = readme.index(results_page.README_BEGIN.format(name=results_page.README_RECORD))
-    block = readme[begin:readme.index(results_page.README_END, begin)]
-    curriculum = record["seeds"]["results"]["curriculum"]["heldout"]["success_rate"]["mean"]
+    begin = readme.index(results_page.BLOCK_BEGIN.format(name=results_page.README_RECORD))
+    block = readme[begin:readme.index(results_page.BLOCK_END, begin)]
+    curriculum = record["data"]["results"]["curriculum"]["heldout"]["success_rate"]["mean"]
     assert f"| curriculum SAC | {curriculum * 100:.1f} %" in block
-    assert block.count("\n| ") == 1 + len(record["seeds"]["results"])  # header and one row per run
+    assert block.count("\n| ") == 1 + len(record["data"]["results"])  # header and one row per run
 
 
 def test_a_changed_number_makes_the_committed_text_stale(tmp_path):
     records = results_page.read_records()
     changed = json.loads(json.dumps(records))
     main = next(r for r in changed if r["name"] == results_page.README_RECORD)
-    stats = main["seeds"]["results"]["curriculum"]["heldout"]["success_rate"]
+    stats = main["data"]["results"]["curriculum"]["heldout"]["success_rate"]
     stats["mean"] = stats["min"] = stats["max"] = 0.123
     readme = (ROOT / "README.md").read_text()
-    expected = results_page.expected_files(changed, readme)
+    expected = results_page.expected_files(changed, {results_page.README: readme})
     assert expected[results_page.README] != readme
     assert expected[results_page.PAGE] != results_page.PAGE.read_text()
     assert "12.3 %" in expected[results_page.PAGE]
@@ -83,13 +83,13 @@ def test_a_record_with_lesson_end_evaluations_gets_its_own_readme_block(tmp_path
     assert "(held-out fixed / moving / `track` / after lesson3 / wall-clock of the whole job): " \
            "seed 0: 95.0 % / - / 2 of 3 track targets / 100.0 % / 20.0 min" in text
     records = results_page.read_records() + [record]
-    readme = (ROOT / "README.md").read_text() + "\n" + results_page.README_BEGIN.format(name="quadruped") + \
-        "\nold\n" + results_page.README_END + "\n"
-    rendered = results_page.expected_files(records, readme)[results_page.README]
-    assert "old" not in rendered.split(results_page.README_BEGIN.format(name="quadruped"))[1]
-    block = rendered.split(results_page.README_BEGIN.format(name="quadruped"))[1]
+    readme = (ROOT / "README.md").read_text() + "\n" + results_page.BLOCK_BEGIN.format(name="quadruped") + \
+        "\nold\n" + results_page.BLOCK_END + "\n"
+    rendered = results_page.expected_files(records, {results_page.README: readme})[results_page.README]
+    assert "old" not in rendered.split(results_page.BLOCK_BEGIN.format(name="quadruped"))[1]
+    block = rendered.split(results_page.BLOCK_BEGIN.format(name="quadruped"))[1]
     assert "| run | held-out, fixed start | `track` | after lesson3 | within 1 cm and 2 deg | median error |" in block
     assert "| curriculum SAC | 95.0 % | 66.7 % | 100.0 % | 47.5 % | 1.00 cm, 1.00 deg |" in block
     assert "| lookup (no learning) | 90.0 % | - | - | 47.5 % | 1.00 cm, 1.00 deg |" in block
     with pytest.raises(ValueError, match="no record 'missing'"):
-        results_page.expected_files(records, readme + results_page.README_BEGIN.format(name="missing"))
+        results_page.expected_files(records, {results_page.README: readme + results_page.BLOCK_BEGIN.format(name="missing")})

@@ -170,7 +170,7 @@ def test_the_results_page_records_one_group_of_a_sweep(finished_sweep, tmp_path,
     out, _ = finished_sweep
     record = results_page.make_record("x", str(out / "sweep.json"), "A title", group="antagonist_pairs",
                                       date="2026-12-04")
-    assert record["command"].startswith("robostrich-sweep --out ") and record["seeds"]["seeds"] == [0, 1]
+    assert record["command"].startswith("robostrich-sweep --out ") and record["data"]["seeds"] == [0, 1]
     text = results_page.render_record(record)
     assert "| curriculum SAC | held-out, fixed start |" in text and "seed 1: " in text
     with pytest.raises(ValueError, match="name one with --group"):
@@ -178,7 +178,7 @@ def test_the_results_page_records_one_group_of_a_sweep(finished_sweep, tmp_path,
     monkeypatch.setattr(results_page, "RECORDS", tmp_path)
     assert results_page.main(["add", "y", str(out / "sweep.json"), "--group", "ventral_slips", "--title", "T"]) == 0
     stored = json.loads((tmp_path / "y.json").read_text())
-    assert stored["seeds"] == json.loads((out / "sweep.json").read_text())["groups"]["ventral_slips"]["aggregate"]
+    assert stored["kind"] == "seeds" and stored["data"] == json.loads((out / "sweep.json").read_text())["groups"]["ventral_slips"]["aggregate"]
 
 
 def _lock_free(run_dir: pathlib.Path) -> bool:

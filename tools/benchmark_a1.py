@@ -1,6 +1,6 @@
 """Environment speed: `robostrich_a1` lesson4 steps/s against raw mj_step of the same model.
 
-    python tools/benchmark_a1.py [--steps 3000] [--task lesson4]
+    python tools/benchmark_a1.py [--steps 2000] [--task lesson4] [--json speed_a1.json]
 
 All runs use the same MJCF and the same 4 physics substeps per control step:
 
@@ -15,6 +15,7 @@ rate of each is kept.
 """
 import argparse
 import os
+import sys
 import time
 
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -54,9 +55,10 @@ def raw_steps_per_second(steps: int, actions: np.ndarray, with_gait: bool = Fals
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--steps", type=int, default=2000)
-    parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--task", default="lesson4", choices=list(robostrich_a1.SUITE))
+    parser.add_argument("--steps", type=int, default=2000, help="control steps per loop and repeat")
+    parser.add_argument("--repeats", type=int, default=3, help="times the three loops run in turn (best kept)")
+    parser.add_argument("--task", default="lesson4", choices=list(robostrich_a1.SUITE), help="the task to step")
+    parser.add_argument("--json", default=None, help="also write the rates and ratios here (a results record's input)")
     args = parser.parse_args(argv)
     actions = benchmarking.random_actions("robostrich_a1", args.task)
     raw = raw_gait = wrapped = 0.0
@@ -71,6 +73,17 @@ def main(argv=None):
           f"(including resets every {quadruped_tasks.LESSON4_TIME_LIMIT:g} s)")
     print(f"ratio env/raw         : {wrapped / raw:10.3f}")
     print(f"ratio (raw+gait)/raw  : {raw_gait / raw:10.3f}")
+    if args.json:
+        benchmarking.write_report(
+            args.json, __file__, argv if argv is not None else sys.argv[1:],
+            f"robostrich_a1/{args.task} against raw mj_step of the same model, the loops in turn "
+            f"{args.repeats} times for {args.steps} control steps, the best rate of each kept",
+            [benchmarking.rate("raw mj_step x4", raw, "control steps/s"),
+             benchmarking.rate("raw mj_step x4 + the gait's joint targets", raw_gait, "control steps/s"),
+             benchmarking.rate(f"robostrich_a1/{args.task}", wrapped, "env steps/s")],
+            [benchmarking.ratio(f"robostrich_a1/{args.task} / raw mj_step", wrapped / raw),
+             benchmarking.ratio("raw + gait / raw mj_step", raw_gait / raw)])
+        print(f"wrote {args.json}")
 
 
 if __name__ == "__main__":

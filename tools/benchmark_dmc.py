@@ -6,7 +6,8 @@
 Benchmark settings as published for state SAC on DMC (PlaNet's action repeats: reacher 4,
 cartpole 8; budgets and evaluation points in environment (control) steps; 10 deterministic
 evaluation episodes).  Default budgets: reacher/easy 200k, cartpole/swingup 100k.  Results go
-to OUT/dmc.json (after every evaluation, so a killed run keeps what it measured) and OUT/dmc.md.
+to OUT/dmc.json (after every evaluation, so a killed run keeps what it measured; a results record's
+input, tools/results_page.py add) and OUT/dmc.md.
 """
 import argparse
 import json
@@ -190,7 +191,8 @@ def main(argv=None) -> int:
         return 2
     os.makedirs(args.out, exist_ok=True)
     rows = []
-    result = {"arguments": vars(args), "configs": {t: c.to_dict() for t, c in configs.items()},
+    command = ["python", "tools/benchmark_dmc.py", *(sys.argv[1:] if argv is None else argv)]
+    result = {"benchmark": "dmc", "command": command, "arguments": vars(args), "configs": {t: c.to_dict() for t, c in configs.items()},
               "reference": {t: {str(s): v for s, v in r.items()} for t, r in REFERENCE.items()},
               "reference_source": REFERENCE_SOURCE, "rows": rows}
 

@@ -1,6 +1,6 @@
 """Environment speed: `robostrich` lesson2 steps/s against raw mj_step of the same model.
 
-    python tools/benchmark_env.py [--steps 1000] [--rounds 21]
+    python tools/benchmark_env.py [--steps 1000] [--rounds 21] [--json speed_env.json]
 
 All run the same MJCF with the same 4 physics substeps per control step, so
 the ratio is the cost of the dm_control wrapper, the task's observation and
@@ -14,6 +14,7 @@ parts ran within a second of each other), with its interquartile range.
 """
 import argparse
 import os
+import sys
 import time
 
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -78,18 +79,17 @@ def bare_loop(actions: np.ndarray) -> benchmarking.EnvLoop:
     return benchmarking.EnvLoop.of(env, actions)
 
 
-def _ratio_line(name: str, raw_seconds, seconds) -> str:
-    ratios = np.array(raw_seconds) / np.array(seconds)
-    low, median, high = np.percentile(ratios, [25, 50, 75])
-    return (f"ratio {name:9s}: {median:10.3f} (median of {len(ratios)} rounds; "
-            f"quartiles {low:.3f}-{high:.3f})")
+def round_ratio(raw_seconds, seconds) -> tuple:
+    """(lower quartile, median, upper quartile) of the rounds' speed ratios against raw."""
+    return tuple(np.percentile(np.array(raw_seconds) / np.array(seconds), [25, 50, 75]))
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--steps", type=int, default=1000, help="control steps per round and loop")
-    parser.add_argument("--rounds", type=int, default=21)
-    parser.add_argument("--task", default="lesson2")
+    parser.add_argument("--rounds", type=int, default=21, help="rounds of the three loops in turn")
+    parser.add_argument("--task", default="lesson2", help="the robostrich task to step")
+    parser.add_argument("--json", default=None, help="also write the rates and ratios here (a results record's input)")
     args = parser.parse_args(argv)
     actions = benchmarking.random_actions("robostrich", args.task)
     raw = RawLoop(actions, benchmarking.episode_steps("robostrich", args.task))
@@ -106,8 +106,24 @@ def main(argv=None):
     print(f"raw mj_step x{raw.substeps} : {best['raw']:10.0f} control steps/s (best round)")
     print(f"bare dm_control: {best['bare']:10.0f} env steps/s (best round)")
     print(f"robostrich/{args.task}: {best['env']:10.0f} env steps/s (best round)")
-    print(_ratio_line("bare/raw", seconds["raw"], seconds["bare"]))
-    print(_ratio_line("env/raw", seconds["raw"], seconds["env"]))
+    ratios = {name: round_ratio(seconds["raw"], seconds[name]) for name in ("bare", "env")}
+    for name, (low, median, high) in ratios.items():
+        print(f"ratio {name + '/raw':9s}: {median:10.3f} (median of {args.rounds} rounds; "
+              f"quartiles {low:.3f}-{high:.3f})")
+    if args.json:
+        benchmarking.write_report(
+            args.json, __file__, argv if argv is not None else sys.argv[1:],
+            f"robostrich/{args.task} against raw mj_step of the same model and episodes, the three loops "
+            f"alternating in {args.rounds} rounds of {args.steps} control steps; each ratio the median of "
+            "the rounds' ratios [quartiles], each rate the best round",
+            [benchmarking.rate(f"raw mj_step x{raw.substeps}", best["raw"], "control steps/s"),
+             benchmarking.rate("bare dm_control environment", best["bare"], "env steps/s"),
+             benchmarking.rate(f"robostrich/{args.task}", best["env"], "env steps/s")],
+            [benchmarking.ratio("bare dm_control / raw mj_step", ratios["bare"][1], ratios["bare"][0],
+                                ratios["bare"][2]),
+             benchmarking.ratio(f"robostrich/{args.task} / raw mj_step", ratios["env"][1], ratios["env"][0],
+                                ratios["env"][2])])
+        print(f"wrote {args.json}")
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 """Speed of the learner and the environment loop, as ratios against plain versions measured in the same run.
 
-    PYTHONPATH=. python tools/benchmark_learner.py [--domain robostrich --task lesson1] [--hidden-sizes 256,256 --batch 256]
+    python tools/benchmark_learner.py [--domain robostrich --task lesson1] [--hidden-sizes 256,256 --batch 256]
+                                      [--json speed_learner.json]
 
 Learner: updates/s of the jitted `lax.scan` update (agents.sac.learning) against
   (a) a plain SAC update written CleanRL-style: each loss jitted on its own,
@@ -113,13 +114,14 @@ def best_rates(variants: dict, seconds: float, rounds: int = 3) -> dict:
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--domain", default="robostrich")
-    p.add_argument("--task", default="lesson1")
-    p.add_argument("--hidden-sizes", default="256,256")
-    p.add_argument("--batch", type=int, default=256)
-    p.add_argument("--updates-per-call", type=int, default=8)
+    p.add_argument("--domain", default="robostrich", help="the domain whose observations and actions are used")
+    p.add_argument("--task", default="lesson1", help="the task stepped by the environment loops")
+    p.add_argument("--hidden-sizes", default="256,256", help="comma-separated hidden layer sizes")
+    p.add_argument("--batch", type=int, default=256, help="transitions per update")
+    p.add_argument("--updates-per-call", type=int, default=8, help="updates fused into one learner call")
     p.add_argument("--seconds", type=float, default=4.0, help="measuring time per variant (split in rounds)")
-    p.add_argument("--action-repeat", type=int, default=5)
+    p.add_argument("--action-repeat", type=int, default=5, help="action repeat of the last loop measured")
+    p.add_argument("--json", default=None, help="also write the rates and ratios here (a results record's input)")
     args = p.parse_args(argv)
     env = make_environment(args.domain, args.task, 0)
     config = SACConfig(batch_size=args.batch, hidden_sizes=tuple(int(h) for h in args.hidden_sizes.split(",")),
@@ -211,6 +213,23 @@ def main(argv=None):
     per_step = 1.0 / repeat_sps + ud / (args.action_repeat * results["ours"])
     print(f"training throughput estimate (action repeat {args.action_repeat}, {ud:g} update per transition): "
           f"{1.0 / per_step:.0f} env steps/s")
+    if args.json:
+        from robostrich_suite import benchmarking
+        benchmarking.write_report(
+            args.json, __file__, argv if argv is not None else sys.argv[1:],
+            f"the learner's jitted update ({config.hidden_sizes} networks, batch {config.batch_size}, "
+            f"{k} updates fused) and the acting loop on {args.domain}/{args.task}, each against a plain "
+            "version in the same run; variants in interleaved rounds, the best round of each kept",
+            [benchmarking.rate(f"learner, one jit with lax.scan x{k}", results["ours"], "updates/s"),
+             benchmarking.rate("plain SAC update, each loss jitted", results["plain_jit_per_loss"], "updates/s"),
+             benchmarking.rate("EnvironmentLoop acting", ours_sps, "env steps/s"),
+             benchmarking.rate("raw env.step, fixed action", raw_sps, "env steps/s")],
+            [benchmarking.ratio("learner / plain SAC update, each loss jitted",
+                                results["ours"] / results["plain_jit_per_loss"]),
+             benchmarking.ratio("learner / plain SAC update without jit", results["ours"] / results["plain_eager"]),
+             benchmarking.ratio("EnvironmentLoop / plain loop (eager policy, lists)", ours_sps / plain_sps),
+             benchmarking.ratio("EnvironmentLoop / raw env.step", ours_sps / raw_sps)])
+        print(f"wrote {args.json}")
 
 
 if __name__ == "__main__":

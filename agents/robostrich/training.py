@@ -1,6 +1,6 @@
 """The main job: curriculum SAC (lessons 1->3) and a plain-SAC baseline, then evaluation, figures and recordings.
 
-    robostrich-train                               # defaults: writes runs/default, about 20 min on 2 CPU cores
+    robostrich-train                               # defaults: writes runs/default (its time: docs/results.md)
     robostrich-train --out runs/default --resume   # continue a killed run from its last checkpoints
 
 Run directory:
@@ -38,14 +38,14 @@ DEFAULT_TOTAL_STEPS = 480_000  # per run, split evenly over the lessons; the two
 # The main job on the frame arm: lessons 1-2 keep 160k control steps each and lesson 3, where the
 # policy refines its reach from moving starts, gets the longest share (280k of 600k), training with
 # a narrower policy Gaussian (target entropy -3 per action instead of -2: about 1 % of an input's
-# range instead of 3 %, where a held input 1 % off already costs a target). Together they brought
-# the share of held-out targets within 1 cm and 2 deg from 62 to over 70 % (docs/learning.md).
+# range instead of 3 %, where a held input 1 % off already costs a target): the long, quiet lesson is
+# what makes the reach precise (docs/learning.md).
 # On the quadruped (Algorithm 1 as the paper ran it) lessons 1-3 on the standing quadruped get the
 # frame's 600k, then lesson 4 (trotting, the trunk height changing) 150k more.
 MAIN_JOB_STEPS = {"robostrich": 600_000, "robostrich_a1": 750_000}
 MAIN_JOB_LESSON_SHARES = {"robostrich": (4, 4, 7), "robostrich_a1": (16, 16, 28, 15)}  # of the curriculum, in order
-# Lesson 4 starts with an empty replay: continuing on the standing lessons' 600k transitions, its
-# own success fell while it trained and the standing one after it to 51-81 % (docs/quadruped.md).
+# Lesson 4 starts with an empty replay: continuing on the standing lessons' transitions, its own
+# success fell while it trained, and with it the standing targets (docs/quadruped.md).
 _NARROW_LESSON3 = {"exploration_lessons": ("lesson3",), "exploration_target_entropy_per_action": -3.0}
 MAIN_JOB_CONFIG = {"robostrich": _NARROW_LESSON3,  # LessonSettings fields
                    "robostrich_a1": {**_NARROW_LESSON3, "fresh_replay_lessons": ("lesson4",)}}
@@ -55,14 +55,13 @@ MAX_TOTAL_STEPS = 100_000_000  # per run: about three days on 2 CPU cores
 # routing of our own.
 DEFAULT_ARM_LAYOUT = layouts.DEFAULT
 # Task arguments of every training lesson on the arm domains, under the ones --task-kwargs gives:
-# a Gaussian position term that keeps paying inside the 5 cm tolerance (rewards.RewardWeights),
-# which brought the median error from 2.5 to under 1 cm; targets drawn by how often the agent
+# a Gaussian position term that keeps paying inside the 5 cm tolerance (rewards.RewardWeights), so
+# the learner still gains by coming closer once it is inside; targets drawn by how often the agent
 # misses them (Reach target_sampling "failures"); and a quarter of lessons 1-2's episodes started
 # at rest at a stored pose (Reach fixed_stored_starts), so that lesson 3 takes over a learner that
-# has already moved out of its curled starts: with both, every seed of eight learns to uncurl the
-# neck, against five with neither; and the same Gaussian term for the head's attitude (1 deg scale),
-# which holds the head level to a fraction of a degree and reached every `track` target on eight
-# seeds (docs/learning.md). '{"weights": {"position_precision": 0, "attitude_precision": 0},
+# has already moved out of its curled starts, which every low-to-high move needs; and the same
+# Gaussian term for the head's attitude (1 deg scale), which holds the head level well inside the
+# 5 deg tolerance (docs/learning.md). '{"weights": {"position_precision": 0, "attitude_precision": 0},
 # "target_sampling": "uniform", "fixed_stored_starts": 0}' gives the paper's eq. 10, draw and
 # starts. Evaluation keeps the task's defaults.
 DEFAULT_ARM_TASK_KWARGS = {"weights": {"position_precision": 1.0, "attitude_precision": 0.5},
@@ -73,8 +72,8 @@ FIXED_START_ARM_TASK_KWARGS = {**DEFAULT_ARM_TASK_KWARGS, "fixed_stored_starts":
 
 
 # On the quadruped a quarter of lesson 4's episodes stand (the standing lessons rehearsed): trained
-# on trotting alone, the policy lost standing targets it had held after lesson 3 (78.6 % on one
-# seed of three, precision 76 -> 11 %; docs/quadruped.md). The standing lessons ignore the option.
+# on trotting alone, the policy could lose standing targets it had held after lesson 3
+# (docs/quadruped.md). The standing lessons ignore the option.
 QUADRUPED_TASK_KWARGS = {"standing_share": 0.25}
 
 

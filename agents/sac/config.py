@@ -72,9 +72,8 @@ class SACConfig:
     policy_average: float = 1e-4
     # ... but early on, while 1 / policy_average is more updates than the run has made, the
     # average spans about this fraction of the updates so far (rate max(policy_average,
-    # 1 / (1 + fraction * updates))) instead of keeping the initial policy's weight: with a
-    # plain EMA at 1e-4, 15k updates (cartpole/swingup's 100k steps) leave 22 % of the
-    # average at the random initial policy (275 against 866 by the last policy); 0 = the
+    # 1 / (1 + fraction * updates))) instead of keeping the initial policy's weight: a plain
+    # EMA at 1e-4 leaves a short run's average mostly at the random initial policy; 0 = the
     # plain EMA.  From 100k updates on the rate is policy_average itself.
     policy_average_fraction: float = 0.1
 

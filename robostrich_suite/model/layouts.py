@@ -44,8 +44,8 @@ DATA_DIR = pathlib.Path(__file__).resolve().parents[1] / "data"
 # Antagonist pairs: the neck cut into four stretches, each with a dorsal and a ventral
 # slip between the same two links, plus the paper's dorsal tendon to the head.  The
 # passive neck is an inverted pendulum; a stretch pulled from both sides holds its bend
-# whichever way gravity turns it.  These cuts held 86 % of the blue region, others
-# tried in short runs 47-71 % (docs/layouts.md).
+# whichever way gravity turns it.  These cuts held the most of the blue region of the
+# cuts tried (docs/layouts.md).
 ANTAGONIST_CUTS = ("c18", "c13", "c9", "c5", "atlas")
 
 

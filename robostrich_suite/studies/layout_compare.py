@@ -20,14 +20,18 @@ Every case is one routing on the same Table 1 links.  Per case:
   the case's own targets; with ``--train``, the held-out success of a short curriculum run of
   ``robostrich-train``'s learner too.
 
-Writes ``layouts.md``, ``layouts.csv``, ``layouts.png`` (blue region with the held
+Writes ``layouts.md``, ``layouts.csv``, ``layouts.json`` (the rows with the command and the blue
+region, what ``tools/results_page.py add`` records), ``layouts.png`` (blue region with the held
 level poses, and the routing on a stick figure, per case) and ``targets/CASE.npz``.
 """
 from __future__ import annotations
 
 import csv
 import dataclasses
+import json
 import pathlib
+import shlex
+import sys
 import time
 
 
@@ -247,6 +251,13 @@ def markdown_table(rows) -> str:
     return "\n".join(lines) + "\n"
 
 
+def describe_samples(blue: dict) -> str:
+    """One line: the blue region and the samples each layout got (a table's caption)."""
+    return (f"Blue region: {blue['level_heads']} level heads among {blue['kinematic_samples']} kinematic samples, "
+            f"{blue['cells']} cells of {blue['cell_size_m'] * 100:g} cm; {blue['random_samples']} random + "
+            f"{blue['level_heads']} sought poses per layout.")
+
+
 def write_csv(path: pathlib.Path, rows) -> None:
     keys = list(dict.fromkeys(key for row in rows for key in row))
     with files.replaced_atomically(path, "w") as f:
@@ -322,28 +333,29 @@ def main(argv=None, parser=None, measures_from_args=lambda args: ()) -> dict:
         raise ValueError(f"no level head among {args.kinematic_samples} kinematic samples; "
                          "raise --kinematic-samples")
     results = measure_all(cases, region, options, args.workers, not args.no_progress)
-    figure = report(args, cases, region, results)
+    figure = report(args, cases, region, results, shlex.join([PROG, *(sys.argv[1:] if argv is None else argv)]))
     print(f"done in {time.perf_counter() - start:.1f} s")
     return {"rows": [r["row"] for r in results], "figure": figure}
 
 
-def report(args, cases, region, results) -> pathlib.Path:
+def report(args, cases, region, results, command: str) -> pathlib.Path:
     """Write layouts.md, layouts.csv and layouts.png under ``args.out`` and print the table."""
     rows = [r["row"] for r in results]
     args.out.mkdir(parents=True, exist_ok=True)
     table = markdown_table(rows)
-    files.write_text(args.out / "layouts.md",
-        f"Blue region: {len(region.head_position)} level heads among {args.kinematic_samples} "
-        f"kinematic samples, {region.num_cells} cells of {coverage_lib.CELL_SIZE * 100:g} cm; "
-        f"{args.random_samples} random + {len(region.head_position)} sought poses per layout.\n\n"
-        + table)
+    blue = {"level_heads": len(region.head_position), "kinematic_samples": args.kinematic_samples,
+            "cells": region.num_cells, "cell_size_m": coverage_lib.CELL_SIZE,
+            "random_samples": args.random_samples}
+    files.write_text(args.out / "layouts.md", describe_samples(blue) + "\n\n" + table)
     write_csv(args.out / "layouts.csv", rows)
+    files.write_text(args.out / "layouts.json", json.dumps(
+        {"benchmark": "layouts", "command": command, "blue_region": blue, "rows": rows}, indent=1) + "\n")
     from robostrich_suite.studies import layout_figure
     figure = layout_figure.plot(cases, region, results, args.out / "layouts.png")
     print(table, end="")
     best = max(rows, key=lambda row: row["coverage"])
     print(f"largest share of the blue region held: {best['layout']} ({best['coverage']:.0%})")
-    for name in ("layouts.md", "layouts.csv"):
+    for name in ("layouts.md", "layouts.csv", "layouts.json"):
         print(f"wrote {args.out / name}")
     print(f"wrote {figure}")
     print(f"wrote {args.out / 'targets'}/ (one target file per layout)")

@@ -188,8 +188,8 @@ def actuated_samples(num_samples: int, seed: int = 0, settle_time: float = SETTL
     """Hold uniformly random tendon inputs and record the settled head poses.
 
     With ``seek_level_time > 0`` the dorsal input of each draw is first tuned for a level
-    head (:func:`seek_level`) and the tuned inputs are held: measured over 60 draws this
-    raises the share of level poses from 3.5 % to 42 % for 2.7 times the simulation.
+    head (:func:`seek_level`) and the tuned inputs are held: many times more level poses
+    for a few times the simulation.
     """
     spec = spec or arm_lib.ArmSpec.from_table1()
     physics = physics or scenes.frame_physics(spec, layout)

@@ -1,0 +1,30 @@
+"""Tables of a "layouts" results record: robostrich-layouts' comparison of tendon routings
+(its layouts.json), rendered with the command's own table so both read alike."""
+import json
+
+ROW_NOISE = ("target_file",)  # where one run wrote its files: not a result
+
+
+def read(data: dict, path: str, group: str = None) -> tuple:
+    if not data.get("rows") or "blue_region" not in data:
+        raise ValueError(f"{path} is not robostrich-layouts' layouts.json (no 'rows'/'blue_region')")
+    if group is not None:
+        raise ValueError(f"--group {group}: {path} is not a sweep")
+    data = json.loads(json.dumps(data))
+    for row in data["rows"]:
+        for key in ROW_NOISE:
+            row.pop(key, None)
+    return data, data.get("command")
+
+
+def caption(data: dict) -> str:
+    from robostrich_suite.studies import layout_compare
+    return layout_compare.describe_samples(data["blue_region"]).rstrip(".")
+
+
+def full(data: dict) -> list:
+    from robostrich_suite.studies import layout_compare
+    return layout_compare.markdown_table(data["rows"]).rstrip("\n").split("\n")
+
+
+short = full
