@@ -174,3 +174,18 @@ def test_env_benchmark_resets_its_raw_baseline_like_the_environment(capsys, tmp_
     assert f"{env_ratio['value']:.3f}" == f"{ratios['env/raw']:.3f}" and env_ratio["low"] <= env_ratio["high"]
     assert f"| ratio robostrich/lesson2 / raw mj_step | **{env_ratio['value']:.3f}** [" in \
         results_page.render_record(record)
+
+
+def test_learner_benchmark_reports_its_ratios_against_plain_versions(tmp_path, tool_env):
+    """At a tiny size: the fused update and the acting loop against their plain versions, printed
+    and written as a speed record (ratios, not judged: any value can come out on a busy machine)."""
+    report = tmp_path / "learner.json"
+    proc = run_tool("benchmark_learner", "--hidden-sizes", "16,16", "--batch", "8", "--seconds", "0.3",
+                    "--json", str(report), cwd=tmp_path, env=tool_env)
+    assert "ratio ours/plain = " in proc.stdout and f"wrote {report}" in proc.stdout
+    record = results_page.make_record("learner", str(report), "Learner", date="2026-12-04")
+    ratios = {row["what"]: row["value"] for row in record["data"]["ratios"]}
+    assert set(ratios) == {"learner / plain SAC update, each loss jitted", "learner / plain SAC update without jit",
+                           "EnvironmentLoop / plain loop (eager policy, lists)", "EnvironmentLoop / raw env.step"}
+    assert all(math.isfinite(value) and value > 0 for value in ratios.values())
+    assert record["command"].startswith("python tools/benchmark_learner.py --hidden-sizes 16,16")

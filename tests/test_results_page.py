@@ -93,3 +93,18 @@ def test_a_record_with_lesson_end_evaluations_gets_its_own_readme_block(tmp_path
     assert "| lookup (no learning) | 90.0 % | - | - | 47.5 % | 1.00 cm, 1.00 deg |" in block
     with pytest.raises(ValueError, match="no record 'missing'"):
         results_page.expected_files(records, {results_page.README: readme + results_page.BLOCK_BEGIN.format(name="missing")})
+
+
+def test_a_changed_number_of_a_record_makes_the_page_that_shows_it_stale():
+    """docs/layouts.md shows the routings' record: a coverage changed in the record is a stale page."""
+    records = json.loads(json.dumps(results_page.read_records()))
+    texts = {path: path.read_text() for path in results_page.block_pages()}
+    layouts_page = ROOT / "docs" / "layouts.md"
+    assert "layouts_comparison" in results_page.blocks(texts[layouts_page])
+    assert results_page.expected_files(records, texts)[layouts_page] == texts[layouts_page]
+    record = next(r for r in records if r["name"] == "layouts_comparison")
+    row = next(r for r in record["data"]["rows"] if r["layout"] == "antagonist_pairs")
+    row["coverage"] = 0.123
+    expected = results_page.expected_files(records, texts)
+    assert expected[layouts_page] != texts[layouts_page] and "| 12% |" in expected[layouts_page]
+    assert "| 12% |" in expected[results_page.PAGE]

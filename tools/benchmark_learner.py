@@ -168,7 +168,8 @@ def main(argv=None):
     # --- environment loop ----------------------------------------------------------------
     chunk = 250
     loop.replay.size = 0  # act with the policy but never learn: measures the acting path only
-    loop.config = SACConfig(**{**config.to_dict(), "min_replay_size": 0, "env_steps_per_call": 10 ** 9,
+    never = SACConfig.LIMITS["env_steps_per_call"]  # no learner call within a measurement
+    loop.config = SACConfig(**{**config.to_dict(), "min_replay_size": 0, "env_steps_per_call": never,
                                "hidden_sizes": config.hidden_sizes, "action_repeat": 1})
     policy_apply = networks.policy_apply  # eager haiku apply, the obvious first version
     params = learner.policy_params

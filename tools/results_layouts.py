@@ -19,7 +19,8 @@ def read(data: dict, path: str, group: str = None) -> tuple:
 
 def caption(data: dict) -> str:
     from robostrich_suite.studies import layout_compare
-    return layout_compare.describe_samples(data["blue_region"]).rstrip(".")
+    text = layout_compare.describe_samples(data["blue_region"]).rstrip(".")
+    return text[0].lower() + text[1:]  # it follows the command and date
 
 
 def full(data: dict) -> list:
