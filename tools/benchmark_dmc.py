@@ -50,13 +50,15 @@ def build_parser():
     p.add_argument("--out", default="runs/dmc", help="writes dmc.json, dmc.md and one directory per run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     g = p.add_argument_group("SAC")
-    g.add_argument("--hidden-sizes", default="256,256")
-    g.add_argument("--batch-size", type=int, default=256)
+    g.add_argument("--hidden-sizes", default="256,256", help="comma-separated hidden layer sizes (default: %(default)s)")
+    g.add_argument("--batch-size", type=int, default=256, help="transitions per update (default: %(default)s)")
     # A critic that learns fast: lr 1e-3, layer-normalised critics, two updates per transition
     # (Acme's 3e-4, no normalisation and one update reached 445 on reacher/easy at 100k, this 907;
     # docs/learning.md).
-    g.add_argument("--learning-rate", type=float, default=1e-3)
-    g.add_argument("--critic-layer-norm", action=argparse.BooleanOptionalAction, default=True)
+    g.add_argument("--learning-rate", type=float, default=1e-3,
+                   help="of critics, actor and temperature (default: %(default)s)")
+    g.add_argument("--critic-layer-norm", action=argparse.BooleanOptionalAction, default=True,
+                   help="layer-normalised critics (default: on)")
     g.add_argument("--updates-per-call", type=int, default=16, help="gradient steps per learner call (default: "
                    "%(default)s, two per transition with --env-steps-per-call 8)")
     g.add_argument("--env-steps-per-call", type=int, default=8, help="agent steps (transitions) between learner calls")

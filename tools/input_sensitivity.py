@@ -35,8 +35,8 @@ def build_parser():
                    help="standard deviations of the constant input error, as fractions of each half-range")
     p.add_argument("--every", type=int, default=4, help="use every N-th training target (default 4)")
     p.add_argument("--draws", type=int, default=3, help="random errors per target and size (default 3)")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", default="runs/sensitivity")
+    p.add_argument("--seed", type=int, default=0, help="seed of the input errors' draws (default: %(default)s)")
+    p.add_argument("--out", default="runs/sensitivity", help="writes sensitivity.json and sensitivity.md here")
     return p
 
 

@@ -42,7 +42,7 @@ def full(data: dict) -> list:
         steps = f"{step // 1000}k" if step % 1000 == 0 else str(step)
         lines.append(f"| {task} | {steps} | " + " | ".join(cells) + f" | {spread} | "
                      + ("-" if reference is None else f"~{reference}") + " |")
-    return lines + ["", f"Published returns: {data.get('reference_source', 'see tools/benchmark_dmc.py')}."]
+    return lines + ["", f"Reference: {data.get('reference_source', 'see tools/benchmark_dmc.py')}."]
 
 
 short = full
