@@ -115,6 +115,10 @@ def test_benchmark_dmc_end_to_end_on_cartpole(tmp_path, tool_env):
     assert f"| cartpole/swingup | 200 | {rows[0]['return_mean']:.0f} |" in page
     assert f"**{last:.0f}** [{last:.0f}, {last:.0f}] | ~835 |" not in page  # no published value at 400 steps
     assert f"**{last:.0f}** [{last:.0f}, {last:.0f}] | - |" in page
+    result["arguments"]["seeds"] = [0, 5]  # a record made while seed 5 still trains says so
+    (out / "dmc.json").write_text(json.dumps(result))
+    page = results_page.render_record(results_page.make_record("dmc", str(out / "dmc.json"), "On dm_control"))
+    assert "over seeds 0 (seed 5 of the command not finished)" in page
 
 
 def test_benchmark_dmc_rejects_unknown_settings_in_one_line():

@@ -22,8 +22,10 @@ def caption(data: dict) -> str:
     seeds = sorted({r["seed"] for r in rows})
     episodes = sorted({r["episodes"] for r in rows})
     repeats = sorted({f"{r['task']} {r['action_repeat']}" for r in rows})
+    missing = [s for s in data.get("arguments", {}).get("seeds", []) if s not in seeds]
+    unfinished = f" (seed {', '.join(map(str, missing))} of the command not finished)" if missing else ""
     return (f"deterministic evaluation return ({'/'.join(map(str, episodes))} episodes per seed and point), "
-            f"mean [min, max] over seeds {', '.join(map(str, seeds))}; action repeats as published "
+            f"mean [min, max] over seeds {', '.join(map(str, seeds))}{unfinished}; action repeats as published "
             f"({', '.join(repeats)})")
 
 
