@@ -60,11 +60,8 @@ def machine() -> str:
 
 
 def kind_of(data: dict) -> str:
-    """What wrote ``data``: a benchmark's own 'benchmark' key, else the seeds (or sweep) aggregate;
-    a dmc.json written before the key existed is known by its published references."""
-    if data.get("benchmark") in KINDS:
-        return data["benchmark"]
-    return "dmc" if "reference_source" in data else "seeds"
+    """What wrote ``data``: a benchmark's own 'benchmark' key, else the seeds (or sweep) aggregate."""
+    return data["benchmark"] if data.get("benchmark") in KINDS else "seeds"
 
 
 def make_record(name: str, path: str, title: str, command: str = None, date: str = None, note: str = "",

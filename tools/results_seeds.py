@@ -15,7 +15,8 @@ def read(data: dict, path: str, group: str = None) -> tuple:
         return sweep_group(data, path, group)
     if "results" not in data or "seeds" not in data:
         raise ValueError(f"{path} is not a tools/benchmark_seeds.py seeds.json nor a robostrich-sweep "
-                         "sweep.json (no 'results'/'seeds', no 'groups')")
+                         "sweep.json (no 'results'/'seeds', no 'groups'), nor names a benchmark this tool "
+                         "records ('benchmark': dmc, layouts or speed)")
     if group is not None:
         raise ValueError(f"--group {group}: {path} is a seeds.json of one group")
     return data, None
