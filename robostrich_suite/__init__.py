@@ -101,10 +101,15 @@ def load(domain_name, task_name, task_kwargs=None, environment_kwargs=None, visu
     if task_name not in domain.SUITE:
         raise ValueError(f"domain {domain_name!r} has no task {task_name!r}; "
                          f"tasks are {list(domain.SUITE)}")
+    if task_kwargs is not None and not isinstance(task_kwargs, dict):
+        raise TypeError(f"task_kwargs must be a dict of the task's options, got {type(task_kwargs).__name__}")
     task_kwargs = dict(task_kwargs or {})
     if isinstance(task_kwargs.get("tendon_layout"), str):  # a built-in layout by name
         from robostrich_suite.model import layouts
-        task_kwargs["tendon_layout"] = layouts.build(task_kwargs["tendon_layout"])
+        try:
+            task_kwargs["tendon_layout"] = layouts.build(task_kwargs["tendon_layout"])
+        except ValueError as error:
+            raise ValueError(f"tendon_layout: {error}") from None
     if environment_kwargs is not None:
         task_kwargs["environment_kwargs"] = environment_kwargs
     return domain.SUITE[task_name](**task_kwargs)

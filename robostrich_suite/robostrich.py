@@ -50,6 +50,7 @@ def track(time_limit=None, random=None, environment_kwargs=None, arm_spec=None,
           tendon_layout=None, targets=None, steps_per_target=TRACK_STEPS_PER_TARGET,
           **task_kwargs):
     """Reach three targets in order (Fig. 7); per-step errors are in the observation."""
+    lessons.check_arm(arm_spec, tendon_layout)
     if targets is None:
         fingerprint_lib.warn_if_other_arm(arm_spec, tendon_layout)
     task = reach.Track(targets=targets, steps_per_target=steps_per_target, random=random,

@@ -31,7 +31,8 @@ from dm_control.utils import containers
 
 from robostrich_suite import physics as physics_lib
 from robostrich_suite import scenes
-from robostrich_suite.tasks import lessons
+from robostrich_suite.model import legs as legs_lib
+from robostrich_suite.tasks import lessons, options, target_samplers
 from robostrich_suite.tasks import quadruped_tasks as tasks
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
 
@@ -64,6 +65,8 @@ def lesson4(time_limit=tasks.LESSON4_TIME_LIMIT, random=None, environment_kwargs
             arm_spec=None, tendon_layout=None, height_range=tasks.LESSON4_HEIGHT_RANGE,
             **task_kwargs):
     """Lesson 4: eq. 10 while the quadruped trots, trunk height changing (random per episode)."""
+    height_range = options.pair("height_range", height_range, legs_lib.MIN_TRUNK_HEIGHT, legs_lib.MAX_TRUNK_HEIGHT,
+                                " m (a trunk height the legs hold)")
     heights = functools.partial(tasks.lesson4_heights, time_limit=time_limit,
                                 height_range=height_range)
     return _FACTORY.lesson("lesson2", "fixed", time_limit, random, environment_kwargs, arm_spec,
@@ -77,6 +80,9 @@ def head_stabilize(time_limit=tasks.HEAD_STABILIZE_TIME_LIMIT, random=None,
                    trunk_heights=tasks.HEAD_STABILIZE_HEIGHTS, **task_kwargs):
     """Sec. 5.2.1: hold the head ``height`` above ground, level, ``distance`` (P_d) ahead of
     the trunk, while walking with the trunk height of Fig. 9A."""
+    reach = target_samplers.MAX_TARGET_DISTANCE
+    distance, height = (options.number(name, value, -reach, reach, f"a finite distance from {-reach:g} to {reach:g} m")
+                        for name, value in (("distance", distance), ("height", height)))
     task = tasks.QuadrupedReach(reward="lesson2", initial_state="fixed", random=random,
                                 legs="walk", trunk_heights=trunk_heights,
                                 target_pool=[[distance, height]], **task_kwargs)

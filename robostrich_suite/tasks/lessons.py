@@ -18,7 +18,8 @@ from typing import Callable
 from dm_control.rl import control
 
 from robostrich_suite import fingerprint as fingerprint_lib
-from robostrich_suite.tasks import reach
+from robostrich_suite.model import arm as arm_lib
+from robostrich_suite.tasks import options, reach
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
 
 LESSON_TIME_LIMIT = 2.0  # s (250 control steps): the tendon servos bring the neck to rest in ~1.5 s
@@ -31,6 +32,16 @@ LESSONS = {
     "lesson3": ("lesson2", "continue", "Lesson 3: as lesson 2, each episode continues from the "
                                        "previous final state"),
 }
+
+
+def check_arm(arm_spec, tendon_layout) -> None:
+    """TypeError naming the option unless each is None or what it names (a string from JSON is
+    not an arm)."""
+    if arm_spec is not None and not isinstance(arm_spec, arm_lib.ArmSpec):
+        raise TypeError(f"arm_spec must be an ArmSpec, got {options.shown(arm_spec)}")
+    if tendon_layout is not None and not isinstance(tendon_layout, arm_lib.TendonLayout):
+        raise TypeError(f"tendon_layout must be a TendonLayout or a built-in layout's name, "
+                        f"got {options.shown(tendon_layout)}")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,9 +57,10 @@ class LessonFactory:
     def environment(self, task, time_limit, arm_spec, tendon_layout, environment_kwargs,
                     **model_kwargs) -> control.Environment:
         time_limit = reach.check_time_limit(time_limit)
+        environment_kwargs = options.environment_kwargs(environment_kwargs)
+        check_arm(arm_spec, tendon_layout)
         physics = self.physics.from_xml_string(
             *self.get_model_and_assets(arm_spec, tendon_layout, **model_kwargs))
-        environment_kwargs = dict(environment_kwargs or {})
         environment_kwargs.setdefault("control_timestep", CONTROL_TIMESTEP)
         return control.Environment(physics, task, time_limit=time_limit, **environment_kwargs)
 
@@ -56,6 +68,7 @@ class LessonFactory:
                tendon_layout, task_kwargs, **task_options) -> control.Environment:
         """A ``reach_task`` environment; warns when the default targets were made with
         another arm than ``arm_spec``/``tendon_layout``."""
+        check_arm(arm_spec, tendon_layout)
         if "target_pool" not in task_kwargs:
             fingerprint_lib.warn_if_other_arm(arm_spec, tendon_layout)
         task = self.reach_task(reward=reward, initial_state=initial_state, random=random,

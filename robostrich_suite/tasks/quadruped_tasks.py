@@ -42,7 +42,7 @@ from robostrich_suite.model import legs
 from robostrich_suite.model import quadruped as quad
 from robostrich_suite import scenes
 from robostrich_suite.tasks import gait as gait_lib
-from robostrich_suite.tasks import reach, target_samplers
+from robostrich_suite.tasks import options, reach, target_samplers
 
 SETTLE_TIME = 0.2  # s of standing physics before each fresh episode
 LESSON4_TIME_LIMIT = 6.0  # s: stand-in, lowered/raised, back (one height change)
@@ -131,8 +131,8 @@ class _QuadrupedTaskMixin:
       gait: for walking, a :class:`gait.TrotGait`, a :class:`gait.GaitReplay` or a gait
         file path (or any object with ``joint_targets(t, trunk_height, stride_scale)``);
         default: replay of the shipped file.
-      trunk_heights: a :class:`gait.TrunkHeightSchedule`, a callable ``random ->
-        schedule`` (a new schedule each episode), or ``None`` (constant nominal height).
+      trunk_heights: a :class:`gait.TrunkHeightSchedule` (or a dict of its fields), a callable
+        ``random -> schedule`` (a new schedule each episode), or ``None`` (constant nominal height).
       steer: keep the walk on the start line (see ``STEER_*``); off = the pure open-loop gait.
       standing_share: for walking, the chance that an episode stands still at the nominal
         height instead (the standing lessons rehearsed, so that training to walk does not
@@ -147,8 +147,10 @@ class _QuadrupedTaskMixin:
                  standing_share: float = 0.0, **kwargs):
         if legs not in ("stand", "walk"):
             raise ValueError(f"unknown legs {legs!r}; use 'stand' or 'walk'")
-        if not 0.0 <= standing_share <= 1.0:  # also refuses NaN
-            raise ValueError(f"standing_share must be a share in [0, 1], got {standing_share!r}")
+        standing_share = options.share("standing_share", standing_share)
+        steer = options.flag("steer", steer)
+        if not callable(trunk_heights):  # a schedule, or a callable drawing one per episode
+            trunk_heights = options.instance("trunk_heights", trunk_heights, gait_lib.TrunkHeightSchedule)
         if legs == "walk":
             if gait is None:
                 gait = gait_lib.GaitReplay.from_file()
@@ -285,11 +287,14 @@ class NarrowGap(_QuadrupedTaskMixin, reach.Track):
     def __init__(self, stop_distance: float = GAP_STOP_DISTANCE, switch: str = "time", **kwargs):
         if switch not in self.SWITCHES:
             raise ValueError(f"unknown switch {switch!r}; use one of {list(self.SWITCHES)}")
+        most = target_samplers.MAX_TARGET_DISTANCE
+        stop_distance = options.number("stop_distance", stop_distance, 0.0, most,
+                                       f"a positive distance, at most {most:g} m", above=True)
         kwargs.setdefault("targets", GAP_TARGETS)
         kwargs.setdefault("steps_per_target", NARROW_GAP_STEPS_PER_TARGET)
         super().__init__(legs="walk", **kwargs)
         self.switch = switch
-        self.stop_distance = float(stop_distance)
+        self.stop_distance = stop_distance
         self.world_targets = np.asarray(self.targets, float) + [scenes.GAP_WALL_X, 0.0]
         self._stopped_at = None
 

@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from robostrich_suite import physics as physics_lib
+from robostrich_suite.tasks import options
 
 
 @dataclasses.dataclass(frozen=True)
@@ -30,13 +31,13 @@ class DomainRandomization:
 
     def __post_init__(self):
         for field in ("mass_scale", "stiffness_scale", "damping_scale", "tendon_gain_scale"):
-            low, high = getattr(self, field)
-            if not 0 < low <= high < math.inf:
-                raise ValueError(f"{field} must be (low, high) with 0 < low <= high, finite, "
+            low, high = options.pair(field, getattr(self, field), 0.0, options.MAX_SCALE)
+            if low <= 0:
+                raise ValueError(f"{field} must be (low, high) with 0 < low <= high <= {options.MAX_SCALE:g}, "
                                  f"got {(low, high)}")
-        if not 0 <= self.joint_angle_noise <= math.pi:  # NaN too
-            raise ValueError(f"joint_angle_noise must be a standard deviation from 0 to pi rad, "
-                             f"got {self.joint_angle_noise}")
+            object.__setattr__(self, field, (low, high))  # JSON's [low, high] as the tuple it stands for
+        options.number("joint_angle_noise", self.joint_angle_noise, 0.0, math.pi,
+                       "a standard deviation from 0 to pi rad")
 
 
 class Randomizer:

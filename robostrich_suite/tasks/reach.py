@@ -24,16 +24,18 @@ from dm_control.suite import base
 from dm_env import specs
 
 from robostrich_suite import physics as physics_lib
+from robostrich_suite.tasks import options
 from robostrich_suite.tasks import randomization as randomization_lib
 from robostrich_suite.tasks import rewards
 from robostrich_suite.tasks.actions import check_action
 from robostrich_suite.tasks.starts import RELEASE_TIME, StartDistribution, check_initial_state
-from robostrich_suite.tasks.target_samplers import TargetSampler, as_targets
+from robostrich_suite.tasks.target_samplers import MAX_TARGET_DISTANCE, TargetSampler, as_targets
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG as DESIRED_ATTITUDE
 from robostrich_suite.tasks.conventions import LEVEL_TOLERANCE_DEG as ATTITUDE_TOLERANCE
-from robostrich_suite.tasks.conventions import POSITION_TOLERANCE
+from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, POSITION_TOLERANCE
 
 REWARDS = ("lesson1", "lesson2")
+MAX_STEPS_PER_TARGET = int(options.MAX_SECONDS / CONTROL_TIMESTEP)  # a target held for the longest episode
 
 
 def _length(vector: np.ndarray) -> float:
@@ -42,10 +44,9 @@ def _length(vector: np.ndarray) -> float:
 
 
 def check_time_limit(time_limit) -> float:
-    """A positive number of seconds (inf: no limit); NaN would never end an episode."""
-    if not (float(time_limit) > 0):
-        raise ValueError(f"time_limit must be positive seconds (or inf), got {time_limit}")
-    return float(time_limit)
+    """A positive number of seconds, at most ``options.MAX_SECONDS``: NaN or 1e300 would never end
+    an episode."""
+    return options.seconds("time_limit", time_limit)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -94,6 +95,7 @@ class Reach(base.Task):
 
     def __init__(self, config: ReachConfig | None = None, random=None, **overrides):
         config = dataclasses.replace(config or default_config(), **overrides)
+        random = options.seed("random", random)
         if config.reward not in REWARDS:
             raise ValueError(f"unknown reward {config.reward!r}; use one of {REWARDS}")
         self.starts = StartDistribution(config.initial_state, config.stored_starts,
@@ -106,9 +108,8 @@ class Reach(base.Task):
         self.sampler = TargetSampler(pool, config.target_sampling)
         self._set_reward(config)
         self._set_target_axes(config.target_axes)
-        randomization = config.randomization
-        if isinstance(randomization, dict):
-            randomization = randomization_lib.DomainRandomization(**randomization)
+        randomization = options.instance("randomization", config.randomization,
+                                         randomization_lib.DomainRandomization)
         self.randomizer = (randomization_lib.Randomizer(randomization)
                            if randomization is not None else None)
         self.target_position = self.target_pool[0].copy()
@@ -120,23 +121,19 @@ class Reach(base.Task):
 
     def _set_reward(self, config: ReachConfig) -> None:
         """Eq. 9 or 10's name, tolerances, desired attitude and weights, checked."""
-        for name in ("position_tolerance", "attitude_tolerance"):
-            value = getattr(config, name)
-            if not (np.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive finite number, got {value}")
-        if not np.isfinite(config.desired_attitude):
-            raise ValueError(f"desired_attitude must be a finite angle in degrees, got {config.desired_attitude}")
-        weights = config.weights
-        if isinstance(weights, dict):
-            weights = rewards.RewardWeights(**weights)
+        self.position_tolerance = options.number(
+            "position_tolerance", config.position_tolerance, 0.0, MAX_TARGET_DISTANCE,
+            f"a positive finite distance, at most {MAX_TARGET_DISTANCE:g} m", above=True)
+        self.attitude_tolerance = options.number("attitude_tolerance", config.attitude_tolerance, 0.0, 180.0,
+                                                 "a positive finite angle, at most 180 deg", above=True)
+        self.desired_attitude = options.number("desired_attitude", config.desired_attitude, -360.0, 360.0,
+                                               "a finite angle in degrees from -360 to 360")
+        weights = options.instance("weights", config.weights, rewards.RewardWeights)
         self.reward_name = config.reward
-        self.position_tolerance = float(config.position_tolerance)
-        self.attitude_tolerance = float(config.attitude_tolerance)
-        self.desired_attitude = float(config.desired_attitude)
         self.weights = weights or rewards.RewardWeights()
 
     def _set_target_axes(self, target_axes) -> None:
-        self.target_axes = tuple(target_axes)
+        self.target_axes = tuple(target_axes) if isinstance(target_axes, (tuple, list, np.ndarray)) else ()
         if (len(self.target_axes) != 2 or len(set(self.target_axes)) != 2
                 or not all(isinstance(a, (int, np.integer)) and 0 <= a <= 2 for a in self.target_axes)):
             raise ValueError(f"target_axes must be two different world axes (0 = x, 1 = y, 2 = z), "
@@ -362,8 +359,8 @@ class Track(Reach):
             from robostrich_suite import targets as targets_lib
             targets = default_track_targets(targets_lib.heldout_targets())
         targets = as_targets(targets, "targets")
-        if isinstance(steps_per_target, bool) or int(steps_per_target) != steps_per_target or steps_per_target < 1:
-            raise ValueError(f"steps_per_target must be a whole number of control steps >= 1, got {steps_per_target}")
+        steps_per_target = options.whole("steps_per_target", steps_per_target, 1, MAX_STEPS_PER_TARGET,
+                                         "a whole number of control steps")
         kwargs.setdefault("reward", "lesson2")
         super().__init__(target_pool=targets, **kwargs)
         self.targets = targets

@@ -9,6 +9,9 @@ import dataclasses
 
 import numpy as np
 
+from robostrich_suite.tasks import options
+from robostrich_suite.tasks.target_samplers import MAX_TARGET_DISTANCE
+
 
 @dataclasses.dataclass(frozen=True)
 class RewardWeights:
@@ -50,13 +53,15 @@ class RewardWeights:
     head_vertical_speed: float = 0.0
 
     def __post_init__(self):
+        scales = {"precision_scale": (MAX_TARGET_DISTANCE, "m"), "attitude_precision_scale": (180.0, "deg")}
         for field in dataclasses.fields(self):
             value = getattr(self, field.name)
-            if not (np.isfinite(value) and value >= 0):
-                raise ValueError(f"reward weight {field.name} must be a finite number >= 0, got {value}")
-        for name in ("precision_scale", "attitude_precision_scale"):
-            if getattr(self, name) <= 0:
-                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
+            if field.name in scales:
+                most, unit = scales[field.name]
+                options.number(field.name, value, 0.0, most, f"> 0 and at most {most:g} {unit}", above=True)
+            else:
+                options.number(f"reward weight {field.name}", value, 0.0, options.MAX_WEIGHT,
+                               f"a finite number from 0 to {options.MAX_WEIGHT:g}")
 
     @property
     def has_precision_terms(self) -> bool:

@@ -18,6 +18,7 @@ import dataclasses
 
 import numpy as np
 
+from robostrich_suite.tasks import options
 from robostrich_suite.tasks.actions import check_action
 
 INITIAL_STATES = ("fixed", "continue")
@@ -25,6 +26,7 @@ INITIAL_STATES = ("fixed", "continue")
 # long as the evaluation's moving starts hold theirs (one 2 s episode), so the arm is at rest.
 STORED_START_SETTLE_TIME = 2.0  # s
 RELEASE_TIME = 1.0  # s: releasing a neck curled back by a turn brings it up to level in 0.8 s
+MAX_TENDON_INPUT = 1.0  # m: a stored pose's tendon input (the arm's inputs are centimetres)
 
 
 def check_initial_state(initial_state: str) -> str:
@@ -46,23 +48,21 @@ class StartDistribution:
     def __post_init__(self):
         check_initial_state(self.initial_state)
         for name in ("stored_starts", "fixed_stored_starts", "release_starts"):
-            share = getattr(self, name)
-            if not (np.isfinite(share) and 0.0 <= share <= 1.0):
-                raise ValueError(f"{name} must be a share between 0 and 1, got {share}")
-            setattr(self, name, float(share))
-        if self.stored_starts > 0 or self.fixed_stored_starts > 0:
-            if self.start_inputs is None:
-                name = "stored_starts" if self.stored_starts > 0 else "fixed_stored_starts"
-                raise ValueError(f"{name} > 0 needs start_inputs: the (n, tendons) tendon inputs "
-                                 "of the stored poses to start from")
-            inputs = np.asarray(self.start_inputs, np.float64)
-            if inputs.ndim != 2 or len(inputs) == 0 or not np.all(np.isfinite(inputs)):
-                raise ValueError("start_inputs must be a non-empty (n, tendons) array of finite tendon "
-                                 f"inputs, got shape {inputs.shape}")
+            setattr(self, name, options.share(name, getattr(self, name)))
+        if self.start_inputs is not None:
+            what = f"a non-empty (n, tendons) array of finite tendon inputs within {MAX_TENDON_INPUT:g} m"
+            inputs = options.array("start_inputs", self.start_inputs, what)
+            if (inputs.ndim != 2 or len(inputs) == 0 or not np.all(np.isfinite(inputs))
+                    or np.any(np.abs(inputs) > MAX_TENDON_INPUT)):
+                raise ValueError(f"start_inputs must be {what}, got shape {inputs.shape}")
             self.start_inputs = inputs
-        if not (np.isfinite(self.release_time) and self.release_time > 0):
-            raise ValueError(f"release_time must be a positive finite time in seconds, got {self.release_time}")
-        self.release_time = float(self.release_time)
+        elif self.stored_starts > 0 or self.fixed_stored_starts > 0:
+            name = "stored_starts" if self.stored_starts > 0 else "fixed_stored_starts"
+            raise ValueError(f"{name} > 0 needs start_inputs: the (n, tendons) tendon inputs "
+                             "of the stored poses to start from")
+        self.release_time = options.number("release_time", self.release_time, 0.0, options.MAX_SECONDS,
+                                           f"a positive finite time in seconds, at most {options.MAX_SECONDS:g}",
+                                           above=True)
 
     def begin(self, physics, random, continuing_state) -> None:
         """Put ``physics`` (just reset to the fixed pose) at this episode's start, drawing from

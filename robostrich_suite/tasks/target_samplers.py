@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from robostrich_suite.tasks import options
+
 TARGET_SAMPLINGS = ("uniform", "failures", "continue_failures")
 MAX_TARGET_DISTANCE = 1.5  # m from the origin of the targets' frame: no arm reaches farther
 
@@ -17,7 +19,7 @@ MAX_TARGET_DISTANCE = 1.5  # m from the origin of the targets' frame: no arm rea
 def as_targets(targets, name: str) -> np.ndarray:
     """(n, 2) finite head positions (x, z); one (2,) position is one target. Anything else (a
     (4, 3) or (1, 4) array) is an error, not silently reshaped into other targets."""
-    array = np.asarray(targets, dtype=np.float64)
+    array = options.array(name, targets, "a non-empty (n, 2) array of (x, z) positions")
     if array.shape == (2,):
         array = array[None]
     if array.ndim != 2 or array.shape[1] != 2 or len(array) == 0:
