@@ -48,7 +48,12 @@ _deferred = 0
 
 class Parser(argparse.ArgumentParser):
     """argparse with a one-line usage error (`PROG: error: ...`, exit 2): the usage of a
-    command with fifty options would bury the line that matters."""
+    command with fifty options would bury the line that matters. Abbreviated flags are refused
+    (``allow_abbrev=False``): `--learning-rat` must not quietly set --learning-rate, nor change
+    meaning when a flag is added."""
+
+    def __init__(self, *args, allow_abbrev: bool = False, **kwargs):
+        super().__init__(*args, allow_abbrev=allow_abbrev, **kwargs)
 
     def error(self, message):
         self.exit(USER_ERROR, f"{self.prog}: error: {' '.join(message.split())} (--help lists the options)\n")

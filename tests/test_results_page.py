@@ -108,3 +108,62 @@ def test_a_changed_number_of_a_record_makes_the_page_that_shows_it_stale():
     expected = results_page.expected_files(records, texts)
     assert expected[layouts_page] != texts[layouts_page] and "| 12% |" in expected[layouts_page]
     assert "| 12% |" in expected[results_page.PAGE]
+
+
+def _damaged_records(tmp_path) -> dict:
+    """{case: folder of records}: the committed records with one of them damaged as ``case`` says."""
+    good = (results_page.RECORDS / f"{results_page.README_RECORD}.json").read_text()
+    record = json.loads(good)
+    damaged = {
+        "list": "[1, 2]",
+        "no_name": json.dumps({k: v for k, v in record.items() if k != "name"}),
+        "no_data": json.dumps({k: v for k, v in record.items() if k != "data"}),
+        "data_of_another_kind": json.dumps({**record, "data": {"rows": []}}),
+        "deep": "[" * 100_000 + "]" * 100_000,
+        "deep_data": json.dumps({**record, "data": {}})[:-2] + '"x": ' + "[" * 100 + "]" * 100 + "}}",
+        "truncated": good[:len(good) // 2],
+        "empty": "",
+        "latin1": good.replace('"note": "', '"note": "caf\u00e9 ', 1),
+    }
+    folders = {}
+    for case, text in damaged.items():
+        folder = tmp_path / case
+        folder.mkdir()
+        for path in results_page.RECORDS.glob("*.json"):
+            (folder / path.name).write_text(path.read_text())
+        target = folder / f"{results_page.README_RECORD}.json"
+        target.write_bytes(text.encode("latin-1" if case == "latin1" else "utf-8"))
+        folders[case] = folder
+    return folders
+
+
+def test_a_damaged_record_is_one_line_naming_it_and_exit_status_2(tmp_path, capsys):
+    """A damaged record is bad input (2), never a stale page (1): CI must not take one for the other."""
+    for case, folder in _damaged_records(tmp_path).items():
+        status = results_page.cli(["--check", "--records", str(folder)])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert status == results_page.BAD_INPUT and len(err) == 1, (case, status, err)
+        assert err[0].startswith("results_page: error: ") and f"{results_page.README_RECORD}.json" in err[0], (case, err)
+    done = subprocess.run([sys.executable, str(ROOT / "tools" / "results_page.py"), "--check", "--records",
+                           str(tmp_path / "deep")], capture_output=True, text=True)
+    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, done.stderr[-2000:]
+    assert "nested too deeply" in done.stderr
+
+
+def test_a_changed_record_is_a_stale_page_exit_status_1(tmp_path, capsys):
+    for path in results_page.RECORDS.glob("*.json"):
+        (tmp_path / path.name).write_text(path.read_text())
+    record = json.loads((tmp_path / f"{results_page.README_RECORD}.json").read_text())
+    record["date"] = "1999-01-01"
+    (tmp_path / f"{results_page.README_RECORD}.json").write_text(json.dumps(record))
+    assert results_page.cli(["--check", "--records", str(tmp_path)]) == results_page.STALE
+    assert "differs from docs/results" in capsys.readouterr().err
+    assert results_page.cli(["--check", "--records", str(results_page.RECORDS)]) == 0
+
+
+def test_a_file_to_add_that_is_damaged_is_named(tmp_path):
+    for text in ("[1]", "{", "{" * 100_000, '{"results": 3, "seeds": [0]}'):
+        bad = tmp_path / "written.json"
+        bad.write_text(text)
+        with pytest.raises(ValueError, match="written.json"):
+            results_page.make_record("x", str(bad), "t", "c")

@@ -54,7 +54,7 @@ def raw_steps_per_second(steps: int, actions: np.ndarray, with_gait: bool = Fals
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0], allow_abbrev=False)
     parser.add_argument("--steps", type=int, default=2000, help="control steps per loop and repeat")
     parser.add_argument("--repeats", type=int, default=3, help="times the three loops run in turn (best kept)")
     parser.add_argument("--task", default="lesson4", choices=list(robostrich_a1.SUITE), help="the task to step")

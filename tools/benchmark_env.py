@@ -85,7 +85,7 @@ def round_ratio(raw_seconds, seconds) -> tuple:
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0], allow_abbrev=False)
     parser.add_argument("--steps", type=int, default=1000, help="control steps per round and loop")
     parser.add_argument("--rounds", type=int, default=21, help="rounds of the three loops in turn")
     parser.add_argument("--task", default="lesson2", help="the robostrich task to step")

@@ -113,7 +113,7 @@ def best_rates(variants: dict, seconds: float, rounds: int = 3) -> dict:
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     p.add_argument("--domain", default="robostrich", help="the domain whose observations and actions are used")
     p.add_argument("--task", default="lesson1", help="the task stepped by the environment loops")
     p.add_argument("--hidden-sizes", default="256,256", help="comma-separated hidden layer sizes")

@@ -54,7 +54,7 @@ def parse_group(text: str):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     parser.add_argument("groups", nargs="+", type=parse_group, metavar="LABEL=GLOB")
     parser.add_argument("--out", required=True, help="PNG to write")
     args = parser.parse_args(argv)

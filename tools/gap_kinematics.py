@@ -154,7 +154,7 @@ def plot(head, neck, masks, pivot_point, rows, mount, path):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     p.add_argument("--layout", default=None, help="built-in tendon layout (default: the suite's)")
     p.add_argument("--transitions", type=int, default=12, help="curled -> raised ramps to simulate (1-200)")
     p.add_argument("--out", default="docs", help="directory for gap_kinematics.png and .json")

@@ -8,6 +8,12 @@
     python tools/results_page.py            # rewrite docs/results.md and every block
     python tools/results_page.py --check    # exit 1 when any of them differs from the records
 
+Exit status: 0 done (with --check: every page matches the records); 1 with --check, a page or a
+block differs from the records (run the tool to rewrite it); 2 bad input: a usage error, or a
+record (or a file given to add) that is not what this tool writes (torn, not UTF-8, nested too
+deeply, not an object, a field missing or of the wrong kind), named in one line. CI can thus tell
+a page merely out of date from a damaged record.
+
 A record (docs/results/NAME.json) keeps what a benchmark wrote, the command that made it, the date
 and the machine. Its kind says which benchmark: "seeds" (one group of robostrich-sweep's
 sweep.json, or an earlier tools/benchmark_seeds.py seeds.json; tools/results_seeds.py renders it),
@@ -34,6 +40,7 @@ import results_speed
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 from robostrich_suite import files  # noqa: E402  (the project's one atomic writer)
+from robostrich_suite import parsing  # noqa: E402  (JSON read with a depth limit, errors naming the file)
 
 RECORDS = ROOT / "docs" / "results"
 PAGE = ROOT / "docs" / "results.md"
@@ -46,6 +53,13 @@ BLOCK_END = "<!-- /results -->"
 README_RECORD = "main_job"  # the README's first table, which it must have
 
 KINDS = {"seeds": results_seeds, "dmc": results_dmc, "layouts": results_layouts, "speed": results_speed}
+STALE, BAD_INPUT = 1, 2  # exit statuses besides 0 (module doc)
+# A record's fields and their types; "note" and "order" may be left out.
+RECORD_FIELDS = {"format": int, "name": str, "title": str, "kind": str, "command": str, "date": str,
+                 "machine": str, "note": str, "order": int, "data": dict}
+OPTIONAL_FIELDS = ("note", "order")
+# What a record's data of the wrong shape raises in its kind's tables: a damaged record, not a bug here.
+SHAPE_ERRORS = (KeyError, TypeError, AttributeError, IndexError, ValueError)
 
 
 def machine() -> str:
@@ -69,28 +83,79 @@ def make_record(name: str, path: str, title: str, command: str = None, date: str
     """A record of what a benchmark wrote: one group of a robostrich-sweep sweep.json (or an earlier
     tools/benchmark_seeds.py seeds.json), tools/benchmark_dmc.py's dmc.json, robostrich-layouts'
     layouts.json or a speed benchmark's --json file; the command it records unless ``command`` says."""
-    with open(path) as f:
-        written = json.load(f)
+    written = parsing.read_json(path)
+    if not isinstance(written, dict):
+        raise ValueError(f"{path}: a JSON {type(written).__name__}, not the object a benchmark writes")
     kind = kind_of(written)
-    data, recorded = KINDS[kind].read(written, path, group)
+    try:
+        data, recorded = KINDS[kind].read(written, path, group)
+    except SHAPE_ERRORS as error:
+        raise _named(error, path, f"not the {kind} file this tool records") from None
     command = command or recorded
     if not command:
         raise ValueError(f"{path} records no command: give --command")
-    return {"format": FORMAT, "name": name, "title": title, "kind": kind, "command": command,
-            "date": date or datetime.date.today().isoformat(), "machine": machine(), "note": note, "data": data}
+    return check_renders({"format": FORMAT, "name": name, "title": title, "kind": kind, "command": command,
+                          "date": date or datetime.date.today().isoformat(), "machine": machine(), "note": note,
+                          "data": data}, path)
+
+
+def _named(error: Exception, path, what: str) -> ValueError:
+    """``error`` as a ValueError naming ``path`` (a message that already names it is kept)."""
+    message = " ".join(str(error).split())
+    if str(path) in message:
+        return ValueError(message)
+    return ValueError(f"{path}: {what} ({type(error).__name__}: {message})")
+
+
+def read_record(path: pathlib.Path) -> dict:
+    """The record in ``path``, checked: its fields, its kind, and that its tables render (a
+    ValueError naming the file otherwise)."""
+    record = parsing.read_json(path)
+    if not isinstance(record, dict):
+        raise ValueError(f"{path}: a JSON {type(record).__name__}, not a record (an object)")
+    if record.get("format") != FORMAT:
+        raise ValueError(f"{path} has record format {record.get('format')!r}, this tool reads {FORMAT}")
+    for field, kind in RECORD_FIELDS.items():
+        if field not in record and field in OPTIONAL_FIELDS:
+            continue
+        if field not in record:
+            raise ValueError(f"{path}: the record has no {field!r}")
+        if not isinstance(record[field], kind) or isinstance(record[field], bool):
+            raise ValueError(f"{path}: the record's {field!r} is a {type(record[field]).__name__}, "
+                             f"not a {kind.__name__}")
+    if record["kind"] not in KINDS:
+        raise ValueError(f"{path} has kind {record['kind']!r}; known: {', '.join(KINDS)}")
+    return check_renders(record, path)
+
+
+def check_renders(record: dict, path) -> dict:
+    """``record`` once its page section and block render; a ValueError naming ``path`` (where its
+    data came from) otherwise."""
+    try:
+        render_record(record)
+        render_block(record)
+    except SHAPE_ERRORS as error:
+        raise _named(error, path, f"its data are not a {record['kind']} record's") from None
+    return record
 
 
 def read_records(directory: pathlib.Path = RECORDS) -> list:
-    records = []
+    records, files_by_name = [], {}
     for path in sorted(directory.glob("*.json")):
-        with open(path) as f:
-            record = json.load(f)
-        if record.get("format") != FORMAT:
-            raise ValueError(f"{path} has record format {record.get('format')}, this tool reads {FORMAT}")
-        if record.get("kind") not in KINDS:
-            raise ValueError(f"{path} has kind {record.get('kind')!r}; known: {', '.join(KINDS)}")
+        record = read_record(path)
+        if record["name"] in files_by_name:
+            raise ValueError(f"{path} and {files_by_name[record['name']]} both name record {record['name']!r}")
+        files_by_name[record["name"]] = path
         records.append(record)
     return sorted(records, key=lambda r: (r.get("order", 100), r["name"]))
+
+
+def read_page(path: pathlib.Path) -> str:
+    """A page that may hold blocks, as text (a ValueError naming it if it is not UTF-8)."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as error:
+        raise ValueError(f"{path}: not a UTF-8 text file (byte {error.start} cannot be decoded)") from None
 
 
 def render_record(record: dict) -> str:
@@ -164,10 +229,12 @@ def expected_files(records: list, texts: dict) -> dict:
     return expected
 
 
-def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False,
+                                epilog=f"exit status: 0 done; {STALE} with --check, a page differs from the records; "
+                                       f"{BAD_INPUT} bad input (a usage error, a damaged record or file)")
     sub = p.add_subparsers(dest="command")
-    add = sub.add_parser("add", help="store what a benchmark wrote as a record in docs/results/")
+    add = sub.add_parser("add", allow_abbrev=False, help="store what a benchmark wrote as a record in docs/results/")
     add.add_argument("name", help="the record's name (docs/results/NAME.json; a block names it)")
     add.add_argument("written", help="OUT/sweep.json of robostrich-sweep (or an earlier seeds.json), dmc.json of "
                      "tools/benchmark_dmc.py, layouts.json of robostrich-layouts, or a speed benchmark's --json file")
@@ -178,8 +245,15 @@ def main(argv=None) -> int:
     add.add_argument("--date", default=None, help="YYYY-MM-DD (default today)")
     add.add_argument("--note", default="", help="one paragraph shown under the title")
     add.add_argument("--order", type=int, default=100, help="position on the page (lower first)")
-    p.add_argument("--check", action="store_true", help="exit 1 when the page or a block differs from the records")
-    args = p.parse_args(argv)
+    p.add_argument("--check", action="store_true",
+                   help=f"exit {STALE} when the page or a block differs from the records (and {BAD_INPUT} when a "
+                        "record is damaged)")
+    p.add_argument("--records", type=pathlib.Path, default=RECORDS, help=argparse.SUPPRESS)  # another folder (tests)
+    return p
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
     if args.command == "add":
         record = make_record(args.name, args.written, args.title, args.run_command, args.date, args.note,
                              args.group)
@@ -188,22 +262,29 @@ def main(argv=None) -> int:
         files.write_text(RECORDS / f"{args.name}.json", json.dumps(record, indent=1) + "\n")
         print(f"wrote {RECORDS / (args.name + '.json')}")
         return 0
-    expected = expected_files(read_records(), {path: path.read_text() for path in block_pages()})
-    stale = [path for path, text in expected.items() if not path.exists() or path.read_text() != text]
+    expected = expected_files(read_records(args.records), {path: read_page(path) for path in block_pages()})
+    stale = [path for path, text in expected.items() if not path.exists() or read_page(path) != text]
     if args.check:
         for path in stale:
             print(f"{path.relative_to(ROOT)} differs from docs/results/*.json: run python tools/results_page.py",
                   file=sys.stderr)
-        return 1 if stale else 0
+        return STALE if stale else 0
     for path in stale:
         files.write_text(path, expected[path])
         print(f"wrote {path.relative_to(ROOT)}")
     return 0
 
 
-if __name__ == "__main__":
+def cli(argv=None) -> int:
+    """``main`` with the exit statuses of the module doc: bad input is one line, status 2."""
     try:
-        sys.exit(main())
+        return main(argv)
     except (ValueError, OSError) as error:
-        print(f"results_page: error: {error}", file=sys.stderr)
-        sys.exit(2)
+        message = error.strerror + (f": {error.filename}" if error.filename else "") \
+            if isinstance(error, OSError) and error.strerror else str(error)
+        print(f"results_page: error: {' '.join(message.split())}", file=sys.stderr)
+        return BAD_INPUT
+
+
+if __name__ == "__main__":
+    sys.exit(cli())

@@ -17,7 +17,16 @@ DEFAULT_LESSONS = LessonSettings(her_lessons=("lesson1",))
 
 
 def parse_plan(text: str, default_domain: str = DEFAULT_DOMAIN):
-    """'lesson1:50000,lesson2:50000' or 'point_mass/easy:2000' -> [Lesson, ...] (the arm by default)."""
+    """'lesson1:50000,lesson2:50000' or 'point_mass/easy:2000' -> [Lesson, ...] (the arm by default).
+    A step count must be whole ('5e4' is, '300.9' is refused rather than cut to 300)."""
+    for item in filter(None, (s.strip() for s in text.split(","))):
+        steps = item.rpartition(":")[2]
+        try:
+            whole = float(steps).is_integer()
+        except ValueError:
+            continue  # not a number: curriculum.parse_plan names the lesson
+        if not whole:
+            raise ValueError(f"lesson {item!r}: {steps} is not a whole number of steps")
     return curriculum.parse_plan(text, default_domain)
 
 

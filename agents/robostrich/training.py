@@ -32,6 +32,7 @@ from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import parsing
 from robostrich_suite.model import layouts
 
 DEFAULT_TOTAL_STEPS = 480_000  # per run, split evenly over the lessons; the two runs train side by side
@@ -180,9 +181,9 @@ positive_int = cli_lib.whole_number(1, MAX_TOTAL_STEPS)  # environment steps
 
 def _json_object(text: str) -> dict:
     try:
-        value = json.loads(text)
-    except json.JSONDecodeError as error:
-        raise argparse.ArgumentTypeError(f"not JSON: {error}") from None
+        value = parsing.loads_json(text)
+    except ValueError as error:  # torn, or nested too deeply
+        raise argparse.ArgumentTypeError(str(error)) from None
     if not isinstance(value, dict):
         raise argparse.ArgumentTypeError(f"expected a JSON object, got {type(value).__name__}")
     return value
@@ -312,11 +313,29 @@ def add_config_arguments(group, defaults):
             group.add_argument(flag, dest=field.name, action=argparse.BooleanOptionalAction,
                                default=default, help=help_text)
         elif isinstance(default, tuple):
-            group.add_argument(flag, dest=field.name, default=",".join(map(str, default)), help=help_text)
+            item_type = typing.get_args(typing.get_type_hints(type(defaults))[field.name])[0]
+            group.add_argument(flag, dest=field.name, type=_comma_list(item_type),
+                               default=",".join(map(str, default)), help=help_text)
         elif default is None:
             group.add_argument(flag, dest=field.name, type=float, default=None, help=help_text)
         else:
             group.add_argument(flag, dest=field.name, type=type(default), default=default, help=help_text)
+
+
+def _comma_list(item_type):
+    """argparse type of a tuple field: the text as given once every item reads as ``item_type``,
+    else a usage error naming the flag (int's own words would not)."""
+
+    def parse(text: str) -> str:
+        for item in filter(None, (part.strip() for part in text.split(","))):
+            try:
+                item_type(item)
+            except ValueError:
+                kind = "whole numbers" if item_type is int else f"{item_type.__name__} values"
+                raise argparse.ArgumentTypeError(f"expected {kind} separated by commas, got {text!r} "
+                                                 f"({item!r} is not one)") from None
+        return text
+    return parse
 
 
 def config_from_args(args, argv=None, cls=SACConfig):
@@ -365,7 +384,10 @@ def _explicit_fields(argv, cls=SACConfig) -> set:
 
 def plan_from_args(args):
     if args.plan:
-        plan = parse_plan(args.plan, default_domain=args.domain)
+        try:
+            plan = parse_plan(args.plan, default_domain=args.domain)
+        except ValueError as error:
+            raise ValueError(f"--plan: {error}") from None
         if sum(l.steps for l in plan) > MAX_TOTAL_STEPS:
             raise ValueError(f"--plan asks for {sum(l.steps for l in plan)} steps, more than {MAX_TOTAL_STEPS}")
         return plan
@@ -684,12 +706,18 @@ def prepare(args, argv) -> _Setup:
     final_domain = Domain(final.domain)
     args.layout = resolve_layout(args.layout, final_domain)
     args.task_kwargs = resolve_task_kwargs(args.task_kwargs, final_domain)
-    domain = Domain(final.domain, args.layout)
+    try:
+        domain = Domain(final.domain, args.layout)
+    except ValueError as error:
+        raise ValueError(str(error) if "--layout" in str(error) else f"--layout {args.layout}: {error}") from None
     for lesson in plan:  # a typo fails now, not after the first lessons have trained
         Domain(lesson.domain).check_task(lesson.task)
     check_task_kwargs(plan, args.layout, args.task_kwargs)
     check_goal_free_terms(args.task_kwargs, config)
-    check_lesson_names(plan, config, lessons, args.layout)
+    try:
+        check_lesson_names(plan, config, lessons, args.layout)
+    except ValueError as error:  # it names the settings' fields; the user typed flags
+        raise ValueError(_with_flags(str(error))) from None
     heldout_task = evaluation.check_heldout_task(domain, args.heldout_task or domain.heldout_task(final.task))
     track_task = evaluation.check_track_task(domain, args.track_task)
     run_plans = {"curriculum": plan}
