@@ -24,6 +24,7 @@ import numpy as np
 
 from robostrich_suite import files
 from robostrich_suite import fingerprint as fingerprint_lib
+from robostrich_suite import parsing
 
 FORMAT_VERSION = 1
 POLICY_DIR = pathlib.Path(__file__).parent / "data" / "policies"
@@ -113,21 +114,83 @@ def read_policy(path) -> Policy:
         if not zipfile.is_zipfile(path):  # numpy would read anything else as a pickle it then refuses
             raise ValueError(f"{path}: not a policy file (not an .npz archive{', it is empty' if path.stat().st_size == 0 else ''})")
         with np.load(path, allow_pickle=False) as data:
-            meta = json.loads(str(data["meta"]))
-            version = meta.get("format_version")
-            if version != FORMAT_VERSION:
-                raise ValueError(f"{path}: policy file format {version}, this code reads format {FORMAT_VERSION}")
+            meta = _metadata(path, data["meta"])
             count = sum(1 for key in data.files if key.startswith("hidden_") and key.endswith("_w"))
             hidden = tuple((data[f"hidden_{i}_w"], data[f"hidden_{i}_b"]) for i in range(count))
-            return Policy(hidden=hidden, mean=(data["mean_w"], data["mean_b"]),
-                          observation_layout=tuple((str(k), int(s)) for k, s in meta["observation_layout"]),
-                          action_low=data["action_low"].astype(np.float64),
-                          action_high=data["action_high"].astype(np.float64),
-                          fingerprint=str(meta["fingerprint"]), info=dict(meta.get("info", {})))
+            policy = Policy(hidden=hidden, mean=(data["mean_w"], data["mean_b"]),
+                            observation_layout=_observation_layout(path, meta["observation_layout"]),
+                            action_low=data["action_low"].astype(np.float64),
+                            action_high=data["action_high"].astype(np.float64),
+                            fingerprint=str(meta["fingerprint"]), info=dict(meta.get("info", {})))
     except FileNotFoundError:
         raise ValueError(f"{path}: no such policy file") from None
-    except (KeyError, OSError, EOFError, zipfile.BadZipFile, json.JSONDecodeError, TypeError, AttributeError) as error:
+    except (KeyError, OSError, EOFError, zipfile.BadZipFile, TypeError, AttributeError) as error:
         raise ValueError(f"{path}: not a policy file ({type(error).__name__}: {error})") from None
+    check_arrays(policy, path)
+    return policy
+
+
+def _metadata(path, stored) -> dict:
+    """The policy file's metadata (JSON), of the format version this code reads."""
+    try:
+        meta = parsing.loads_json(str(stored))
+    except ValueError as error:
+        raise ValueError(f"{path}: not a policy file (its metadata: {error})") from None
+    if not isinstance(meta, dict):
+        raise ValueError(f"{path}: not a policy file (its metadata is a JSON {type(meta).__name__}, not an object)")
+    version = meta.get("format_version")
+    if version != FORMAT_VERSION:
+        raise ValueError(f"{path}: policy file format {version!r}, this code reads format {FORMAT_VERSION}")
+    if not isinstance(meta.get("fingerprint"), str) or not isinstance(meta.get("info", {}), dict):
+        raise ValueError(f"{path}: not a policy file (its metadata lacks the model fingerprint, a string, or "
+                         "holds an 'info' that is not an object)")
+    return meta
+
+
+def _observation_layout(path, layout) -> tuple:
+    """((key, size), ...) from the metadata: keys named, sizes whole and positive."""
+    try:
+        pairs = tuple((key, size) for key, size in layout)
+    except (TypeError, ValueError):
+        pairs = None
+    if (not pairs or not all(isinstance(k, str) and isinstance(s, int) and not isinstance(s, bool) and 0 < s < 2**20
+                             for k, s in pairs)):
+        raise ValueError(f"{path}: not a policy file (its observation layout is not [[key, size], ...] "
+                         f"with positive sizes)")
+    return pairs
+
+
+def check_arrays(policy: Policy, path) -> None:
+    """ValueError naming ``path`` unless the layers chain from the observation's size to the
+    action's, and every number is finite: a wrong shape would fail in numpy's matmul with
+    nothing about the file, NaN weights in the first step of an evaluation."""
+    arrays = [(f"hidden_{i}_{part}", a) for i, layer in enumerate(policy.hidden) for part, a in zip("wb", layer)]
+    arrays += [("mean_w", policy.mean[0]), ("mean_b", policy.mean[1]),
+               ("action_low", policy.action_low), ("action_high", policy.action_high)]
+    for name, array in arrays:
+        if array.dtype.kind != "f":
+            raise ValueError(f"{path}: {name} holds {array.dtype} values, not floating-point weights")
+        if not np.all(np.isfinite(array)):
+            raise ValueError(f"{path}: {name} holds non-finite values (NaN or inf): not a usable policy")
+    if policy.action_low.ndim != 1:
+        raise ValueError(f"{path}: action_low has shape {policy.action_low.shape}, expected (n,): one bound per action")
+    width, actions = policy.observation_size, policy.action_low.shape[0]  # what the next layer reads; gives
+    expected = {}
+    for i, _ in enumerate(policy.hidden):
+        out = policy.hidden[i][0].shape[-1] if policy.hidden[i][0].ndim == 2 else None
+        expected[f"hidden_{i}_w"], expected[f"hidden_{i}_b"] = (width, out), (out,)
+        width = out
+    expected.update(mean_w=(width, actions), mean_b=(actions,), action_low=(actions,), action_high=(actions,))
+    for name, array in arrays:
+        if None in expected[name] or array.shape != expected[name]:
+            reads = f" (the observation layout reads {policy.observation_size} values)" if name == "hidden_0_w" else ""
+            raise ValueError(f"{path}: {name} has shape {array.shape}, expected {_shape(expected[name])}{reads}")
+    if not np.all(policy.action_low < policy.action_high):
+        raise ValueError(f"{path}: action_low must lie below action_high for every action")
+
+
+def _shape(shape: tuple) -> str:
+    return "(" + ", ".join("n" if n is None else str(n) for n in shape) + ("," if len(shape) == 1 else "") + ")"
 
 
 def load_policy(name_or_path: str = "robostrich", env=None) -> Policy:
