@@ -89,10 +89,7 @@ def check_recorded_groups(out: str, groups) -> None:
     """A group keeps the flags it started with (OUT/grid.json): a finished run of other settings
     would otherwise be counted as this one's. Groups may be added."""
     path = os.path.join(out, "grid.json")
-    recorded = {}
-    if os.path.exists(path):
-        with open(path) as f:
-            recorded = json.load(f)
+    recorded = sweep_grid.read_recorded_groups(path)
     for group in groups:
         if group.name in recorded and recorded[group.name] != list(group.arguments):
             raise ValueError(f"group {group.name} ran with {' '.join(recorded[group.name]) or 'no flags'} in {out}, "

@@ -20,8 +20,9 @@ import dataclasses
 import json
 import os
 import re
-import tomllib
 from typing import Optional
+
+from robostrich_suite import parsing
 
 GRID_KEYS = ("seeds", "layouts", "train", "settings")
 PER_RUN_FLAGS = ("--seed", "--out", "--resume", "--workers")  # the sweep sets these for each run
@@ -64,12 +65,9 @@ class Run:
 
 
 def read_grid_file(path: str) -> dict:
-    """The grid file's tables, every key known (a typo is an error, not an ignored line)."""
-    with open(path, "rb") as f:
-        try:
-            grid = tomllib.load(f)
-        except tomllib.TOMLDecodeError as error:
-            raise ValueError(f"{path} is not TOML: {error}") from None
+    """The grid file's tables, every key known (a typo is an error, not an ignored line); a file
+    that is not TOML (torn, not UTF-8, nested too deeply) is a ValueError naming it."""
+    grid = parsing.read_toml(path)
     unknown = sorted(set(grid) - set(GRID_KEYS))
     if unknown:
         raise ValueError(f"{path}: unknown key {', '.join(unknown)} (known: {', '.join(GRID_KEYS)})")
@@ -80,6 +78,19 @@ def read_grid_file(path: str) -> dict:
         if not isinstance(table, dict):
             raise ValueError(f"{path}: settings.{name} must be a table ([settings.{name}])")
     return grid
+
+
+def read_recorded_groups(path: str) -> dict:
+    """OUT/grid.json, the flags each group of a sweep started with ({} before the first run); a
+    torn or foreign file is a ValueError naming it."""
+    if not os.path.exists(path):
+        return {}
+    recorded = parsing.read_json(path)
+    if not (isinstance(recorded, dict) and all(isinstance(flags, list) and all(isinstance(f, str) for f in flags)
+                                               for flags in recorded.values())):
+        raise ValueError(f"{path}: not the sweep's record of its groups ({{group: [flags, ...]}}); "
+                         "choose another --out")
+    return recorded
 
 
 def flags_of(table: dict, where: str) -> list:
