@@ -27,6 +27,7 @@ TINY = ["--plan", "lesson1:100,lesson2:100,lesson3:100", "--hidden-sizes", "16,1
         "--min-replay-size", "20", "--num-eval-targets", "1", "--final-eval-targets", "1", "--eval-every", "1000000",
         "--checkpoint-every", "100", "--no-baseline", "--track-task", "", "--no-rerun", "--no-figures"]
 GRID = ["--seeds", "0,1", "--layouts", "ventral_slips,antagonist_pairs", "--num-cpus", "2", "--quiet", *TINY]
+CHECKPOINT = "checkpoint.pkl"  # a run's checkpoint, in RUN/curriculum/
 RUNS = [(layout, seed) for layout in ("ventral_slips", "antagonist_pairs") for seed in (0, 1)]
 
 
@@ -201,65 +202,155 @@ def _wait_for(condition, what, timeout=600, every=0.05):
         time.sleep(every)
 
 
+def _checkpointed(run_dir: pathlib.Path) -> bool:
+    return (run_dir / "curriculum" / CHECKPOINT).exists()
+
+
 def _mid_training(run_dir: pathlib.Path) -> bool:
     """A checkpoint written and fewer than its three lesson-end evaluations: still training."""
     evals = run_dir / "curriculum" / "evals.jsonl"
-    return (run_dir / "curriculum" / "checkpoint.pkl").exists() and evals.exists() and \
-        len(evals.read_text().splitlines()) < 3
+    return _checkpointed(run_dir) and evals.exists() and len(evals.read_text().splitlines()) < 3 \
+        and not (run_dir / "summary.json").exists()
 
 
-def test_a_killed_sweep_reruns_nothing_finished_and_resumes_the_rest_bit_for_bit(finished_sweep, command_env):
-    """One layout's two seeds on one CPU: the first has finished when the second is caught mid-training."""
+def _trainer(run_dir: pathlib.Path):
+    """The process id of the robostrich-train that holds ``run_dir`` (from its lock file), else None."""
+    try:
+        pid = int((run_dir / ".lock").read_text().strip())
+        status = pathlib.Path(f"/proc/{pid}/status").read_text()
+        command = pathlib.Path(f"/proc/{pid}/cmdline").read_bytes()
+    except (OSError, ValueError):
+        return None
+    alive = "\nState:\tZ" not in status
+    return pid if alive and b"robostrich-train" in command else None
+
+
+def _told_to_stop(pid: int) -> bool:
+    """Whether SIGTERM or SIGINT waits to be delivered to the (stopped) process ``pid``."""
+    status = pathlib.Path(f"/proc/{pid}/status").read_text()
+    pending = {line.split(":")[0]: int(line.split()[1], 16) for line in status.splitlines()
+               if line.startswith(("SigPnd:", "ShdPnd:"))}
+    mask = (1 << (signal.SIGTERM - 1)) | (1 << (signal.SIGINT - 1))
+    return any(bits & mask for bits in pending.values())
+
+
+def _stop_mid_training(run_dir: pathlib.Path, process, timeout=600):
+    """SIGSTOP the run's training while it is mid-training (a checkpoint written, not finished):
+    stopped first and looked at then, so that it cannot finish between the look and the stop.
+    Returns its process id."""
+    deadline = time.time() + timeout
+    while time.time() < deadline and process.poll() is None:
+        pid = _trainer(run_dir)
+        if pid is not None:
+            os.kill(pid, signal.SIGSTOP)
+            if _mid_training(run_dir):
+                return pid
+            os.kill(pid, signal.SIGCONT)
+        time.sleep(0.05)
+    raise AssertionError(f"{run_dir} was not caught mid-training (sweep status {process.poll()})")
+
+
+def test_a_killed_sweep_stops_its_runs_with_a_checkpoint_and_resumes_them_bit_for_bit(finished_sweep, command_env):
+    """SIGKILL to the sweep while its second run trains (its first finished): the run stops, as by
+    SIGTERM, with a checkpoint of where it was; started again, the sweep reruns nothing finished
+    and resumes the rest, and every run ends as in the uninterrupted sweep. The training is held
+    (SIGSTOP) while the sweep is killed, so the run cannot finish in the meantime."""
     reference, _ = finished_sweep
     out = short_dir() / "sweep"
-    runs = RUNS[:2]
     grid = ["--seeds", "0,1", "--layouts", "ventral_slips", "--num-cpus", "1", "--quiet", *TINY]
-    dirs = {run: out / "runs" / run[0] / f"seed_{run[1]}" for run in runs}
+    dirs = {seed: out / "runs" / "ventral_slips" / f"seed_{seed}" for seed in (0, 1)}
     process = sweep("--out", out, *grid, env=command_env)
+    pid = None
     try:
-        _wait_for(lambda: any((d / "summary.json").exists() for d in dirs.values())
-                  and any(_mid_training(d) for d in dirs.values()) or process.poll() is not None,
-                  "a finished run beside one still training")
-        assert process.poll() is None, "the sweep ended before a run was caught mid-training"
+        _wait_for(lambda: (dirs[0] / "summary.json").exists() or process.poll() is not None, "the first run")
+        pid = _stop_mid_training(dirs[1], process)
         process.send_signal(signal.SIGKILL)
+        process.communicate()
+        _wait_for(lambda: _told_to_stop(pid), "the run to be told to stop", timeout=120)
     finally:
         process.kill()
         process.communicate()
+        if pid is not None:
+            os.kill(pid, signal.SIGCONT)
     assert process.returncode == -signal.SIGKILL
-    done = {run: os.stat(d / "summary.json") for run, d in dirs.items() if (d / "summary.json").exists()}
-    assert done and len(done) < len(runs)
-    _wait_for(lambda: all(_lock_free(d) for d in dirs.values()), "the killed runs' processes to end", timeout=60)
+    _wait_for(lambda: _lock_free(dirs[1]), "the stopped run to write its checkpoint and end", timeout=300)
+    log = (dirs[1] / "train.log").read_text()
+    assert "robostrich-train: terminated (checkpoint written at step " in log, log[-2000:]
+    assert not (dirs[1] / "summary.json").exists()
+    done = os.stat(dirs[0] / "summary.json")
     result = finish(sweep("--out", out, *grid, env=command_env))
     assert result.returncode == 0, result.stderr[-3000:]
-    assert f"{len(done)} of 2 runs finished, {2 - len(done)} to run (" in result.stderr
-    assert " 0 resumed)" not in result.stderr
-    for run, stat in done.items():  # not run again
-        again = os.stat(dirs[run] / "summary.json")
-        assert (again.st_ino, again.st_mtime_ns) == (stat.st_ino, stat.st_mtime_ns), run
-    for run, run_dir in dirs.items():  # every run as the uninterrupted sweep's
-        assert outcome(run_dir) == outcome(reference / "runs" / run[0] / f"seed_{run[1]}"), run
+    assert "1 of 2 runs finished, 1 to run (1 resumed)" in result.stderr, result.stderr[-3000:]
+    again = os.stat(dirs[0] / "summary.json")  # not run again
+    assert (again.st_ino, again.st_mtime_ns) == (done.st_ino, done.st_mtime_ns)
+    for seed, run_dir in dirs.items():  # every run as the uninterrupted sweep's
+        assert outcome(run_dir) == outcome(reference / "runs" / "ventral_slips" / f"seed_{seed}"), seed
     assert json.loads((out / "sweep.json").read_text())["finished"] == 2
     subprocess.run(["rm", "-rf", str(out.parent)], check=True)
 
 
+def test_sigterm_stops_a_sweep_as_ctrl_c_and_a_second_sweep_into_its_directory_is_refused(command_env, tmp_path):
+    """A scheduler's SIGTERM: every running run writes its checkpoint, sweep.json says so, exit
+    143 with one line, and Ray's temporary directory is gone. While it runs, another sweep into
+    its --out is refused in one line and changes nothing. Runs too long to end on their own."""
+    long_plan = [a if a != TINY[1] else "lesson1:100,lesson2:100,lesson3:1000000" for a in TINY]
+    temp = short_dir()  # TMPDIR of this test alone: --out is too long for Ray's sockets, so they go there
+    env = {**command_env, "TMPDIR": str(temp)}
+    out = tmp_path / "sweep"
+    grid = ["--seeds", "0,1", "--num-cpus", "2", "--quiet", *long_plan]
+    dirs = [out / "runs" / "default" / f"seed_{seed}" for seed in (0, 1)]
+    process = sweep("--out", out, *grid, env=env)
+    try:
+        _wait_for(lambda: all(_checkpointed(d) for d in dirs) or process.poll() is not None, "both runs to train")
+        assert process.poll() is None, process.communicate()[1][-3000:]
+        before = {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file() and p.name != "train.log"}
+        second = finish(sweep("--out", out, *grid, env=env), timeout=300)
+        lines = second.stderr.strip().splitlines()
+        assert second.returncode == 2 and len(lines) == 1, second.stderr[-3000:]
+        assert lines[0].startswith("robostrich-sweep: error: ") and "in use by another robostrich-sweep" in lines[0]
+        process.send_signal(signal.SIGTERM)
+        result = finish(process, timeout=600)
+    finally:
+        process.kill()
+        process.communicate()
+    assert all(p.stat().st_mtime_ns >= t for p, t in before.items() if p.exists())
+    assert result.returncode == 143, result.stderr[-3000:]
+    assert result.stderr.strip().splitlines()[-1] == "robostrich-sweep: terminated", result.stderr[-3000:]
+    assert "SIGTERM" not in result.stderr and "Traceback" not in result.stderr, result.stderr[-3000:]
+    for run_dir in dirs:
+        assert "(checkpoint written at step " in (run_dir / "train.log").read_text()
+    table = json.loads((out / "sweep.json").read_text())
+    assert [r["status"] for r in table["runs"]] == ["interrupted", "interrupted"]
+    assert not any(temp.iterdir()), list(temp.rglob("*"))
+    subprocess.run(["rm", "-rf", str(temp)], check=True)
+
+
 def test_a_failing_run_is_reported_and_the_others_finish(command_env, tmp_path):
-    grid = tmp_path / "grid.toml"  # robostrich-train parses the bad option; its task refuses it
-    grid.write_text('seeds = [0]\n[settings.plain]\n[settings.bad]\ntask-kwargs = {no_such_option = 1}\n')
-    out = tmp_path / "sweep"  # too long a path for Ray's sockets (and so is TMPDIR): they go to /tmp
-    before = set(pathlib.Path("/tmp").glob("robostrich-sweep-*"))
-    result = finish(sweep("--grid", grid, "--out", out, "--num-cpus", "2", "--quiet", *TINY, env=command_env))
-    assert set(pathlib.Path("/tmp").glob("robostrich-sweep-*")) == before  # removed at the end
+    """A run that robostrich-train refuses once it starts (its checkpoint damaged) is listed with
+    its one-line error while the other run finishes; a bad option would stop the sweep before
+    any run (test_bad_input_and_a_missing_ray_are_one_line_and_exit_2)."""
+    grid = tmp_path / "grid.toml"
+    grid.write_text('seeds = [0]\n[settings.plain]\n[settings.bad]\n')
+    out = tmp_path / "sweep"  # too long a path for Ray's sockets: they go to TMPDIR, this test's own
+    damaged = out / "runs" / "bad" / "seed_0" / "curriculum" / CHECKPOINT
+    damaged.parent.mkdir(parents=True)
+    damaged.write_bytes(b"not a checkpoint")
+    temp = short_dir()
+    result = finish(sweep("--grid", grid, "--out", out, "--num-cpus", "2", "--quiet", *TINY,
+                          env={**command_env, "TMPDIR": str(temp)}))
+    assert not any(temp.iterdir()), list(temp.rglob("*"))  # removed at the end
+    temp.rmdir()
     assert result.returncode == 1, result.stderr[-3000:]
     failure = [line for line in result.stderr.splitlines() if line.startswith("robostrich-sweep: run ")]
     assert len(failure) == 1 and failure[0].startswith("robostrich-sweep: run bad seed 0 failed: robostrich-train: "
-                                                       "error: --task-kwargs"), result.stderr[-3000:]
-    assert "no_such_option" in failure[0]
+                                                       "error: "), result.stderr[-3000:]
+    assert str(damaged) in failure[0] and "(exit status 2; log: " in failure[0]
     assert (out / "runs" / "plain" / "seed_0" / "summary.json").exists()
     table = json.loads((out / "sweep.json").read_text())
     assert (table["finished"], [f["group"] for f in table["failed"]]) == (1, ["bad"])
     assert table["groups"]["bad"]["aggregate"] is None
     markdown = (out / "sweep.md").read_text()
-    assert "## Failed runs" in markdown and "- bad seed 0: robostrich-train: error: --task-kwargs" in markdown
+    assert "## Failed runs" in markdown and "- bad seed 0: robostrich-train: error: " in markdown
     assert not (out / "ray").exists()
 
 
@@ -273,12 +364,18 @@ def test_bad_input_and_a_missing_ray_are_one_line_and_exit_2(command_env, tmp_pa
                                    stderr=subprocess.PIPE, text=True, env=command_env),
         "bad flag": sweep("--out", tmp_path / "b", "--her-ratio", "x", env=command_env),
         "per run": sweep("--out", tmp_path / "c", "--seed", "3", env=command_env),
-        "layout": sweep("--out", tmp_path / "d", "--layouts", "ventral_slips,nope", env=command_env)}
+        "layout": sweep("--out", tmp_path / "d", "--layouts", "ventral_slips,nope", env=command_env),
+        "value": sweep("--out", tmp_path / "e", "--learning-rate", "-1", env=command_env),
+        "option": sweep("--out", tmp_path / "g", "--task-kwargs", '{"no_such_option": 1}', env=command_env),
+        "address": sweep("--out", tmp_path / "f", "--address", "127.0.0.1:1", *TINY, env=command_env)}
     results = {name: finish(p, timeout=300) for name, p in processes.items()}
     expected = {"no ray": "Ray is not installed; pip install -e '.[sweep]'",
                 "bad flag": "group default: robostrich-train: argument --her-ratio: invalid float value: 'x'",
                 "per run": "--seed is set for each run by robostrich-sweep",
-                "layout": "unknown layout 'nope'"}
+                "layout": "unknown layout 'nope'",
+                "value": "group default: robostrich-train: --learning-rate",
+                "option": "group default: robostrich-train: --task-kwargs",
+                "address": "--address 127.0.0.1:1: no Ray cluster answers there"}
     for name, result in results.items():
         lines = result.stderr.strip().splitlines()
         assert result.returncode == 2 and len(lines) == 1, (name, result.stderr[-2000:])

@@ -15,7 +15,7 @@ import json
 import os
 import sys
 
-from agents.robostrich import sweep_grid, sweep_ray, sweep_table
+from agents.robostrich import directory_lock, sweep_grid, sweep_ray, sweep_table
 from agents.robostrich import training  # robostrich-train's own parser checks every group's flags
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.files import write_text
@@ -76,13 +76,20 @@ def plan(args, passthrough):
 
 
 def check_training_flags(group) -> None:
-    """robostrich-train's parser on the group's flags: its usage error as a ValueError naming the group."""
+    """robostrich-train's own checks of the group's flags (its parser, then every value, lesson and
+    task option, as it checks them before it trains): a ValueError naming the group, before any run
+    of the sweep starts, instead of each run failing in turn."""
     parser = training.build_parser()
 
     def refuse(message):
         raise ValueError(f"group {group.name}: robostrich-train: {' '.join(message.split())}")
     parser.error = refuse
-    parser.parse_args(list(group.arguments))
+    argv = list(group.arguments)
+    args = parser.parse_args(argv)
+    try:
+        training.prepare(args, argv)
+    except (ValueError, TypeError) as error:
+        refuse(str(error))
 
 
 def check_recorded_groups(out: str, groups) -> None:
@@ -185,7 +192,9 @@ def main(argv=None) -> dict:
     args, passthrough = build_parser().parse_known_args(argv)
     sweep_ray.check_installed()
     groups, runs = plan(args, passthrough)
-    os.makedirs(args.out, exist_ok=True)
+    if args.address is not None:
+        sweep_ray.check_reachable(args.address)
+    lock = directory_lock.lock_directory(args.out, PROG)  # noqa: F841  (held until this process ends)
     check_recorded_groups(args.out, groups)
     command = [PROG, *(sys.argv[1:] if argv is None else argv)]
     pending = [run for run in runs if not run.finished()]

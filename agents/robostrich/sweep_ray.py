@@ -16,6 +16,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 INSTALL_HINT = "Ray is not installed; pip install -e '.[sweep]' (or pip install ray==2.60.0)"
@@ -27,6 +28,8 @@ SOCKET_TAIL = 1 + 42 + len("/sockets/plasma_store") + 3
 # One intra-op thread per run, as robostrich-train's own workers have (agents/robostrich/training.py).
 ONE_THREAD_XLA = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
 INTERRUPT_GRACE_S = 300  # how long an interrupted run may take to write its checkpoints
+CONNECT_TIMEOUT_S = 10.0  # how long --address may stay silent before the sweep gives up
+LAUNCHER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "run_launcher.py")
 _LOCAL_TOKEN = secrets.token_hex(32)  # a local Ray's token: one per process (Ray keeps the first it reads)
 
 
@@ -84,6 +87,40 @@ def _environment(**values):
                 os.environ[key] = value
 
 
+def check_reachable(address: str, timeout_s: float = CONNECT_TIMEOUT_S) -> None:
+    """A ValueError naming ``address`` when nothing answers there within ``timeout_s``: Ray itself
+    retries an absent cluster for minutes, with warnings of many lines, deaf to SIGTERM meanwhile."""
+    import socket
+    host, _, port = address.split("://")[-1].rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ValueError(f"--address {address}: expected host:port or ray://host:port")
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s).close()
+    except OSError as error:
+        reason = error.strerror or str(error) or type(error).__name__
+        raise ValueError(f"--address {address}: no Ray cluster answers there ({reason}, "
+                         f"waited at most {timeout_s:g} s)") from None
+
+
+@contextlib.contextmanager
+def _own_stop_signals():
+    """Ray's init sets a SIGTERM handler that exits the driver at once (its tasks unstopped, their
+    checkpoints unwritten): the command's own handler is put back, so SIGTERM stops the sweep as
+    Ctrl-C does."""
+    handler = signal.getsignal(signal.SIGTERM)
+    try:
+        yield
+    finally:
+        if handler is not None and threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, handler)
+
+
+def _init(ray, **kwargs):
+    """ray.init quietly, the stop signals kept as the command set them."""
+    with _own_stop_signals():
+        ray.init(log_to_driver=False, logging_level="WARNING", **kwargs)
+
+
 @contextlib.contextmanager
 def connected(out: str, address=None, num_cpus=None):
     """Ray (the module) for the block: the cluster at ``address``, else a local one of ``num_cpus``
@@ -92,7 +129,7 @@ def connected(out: str, address=None, num_cpus=None):
         ray = import_ray()
         try:
             try:
-                ray.init(address=address, log_to_driver=False, logging_level="WARNING")
+                _init(ray, address=address)
             except (ConnectionError, RuntimeError) as error:  # no cluster there, or one that refuses us
                 raise ValueError(f"--address {address}: {' '.join(str(error).split())[:300]}") from None
             yield ray
@@ -106,8 +143,7 @@ def connected(out: str, address=None, num_cpus=None):
             ray = import_ray()
             try:  # a Ctrl-C while Ray starts stops what has started
                 try:
-                    ray.init(num_cpus=num_cpus or os.cpu_count() or 1, include_dashboard=False, _temp_dir=temp_dir,
-                             log_to_driver=False, logging_level="WARNING")
+                    _init(ray, num_cpus=num_cpus or os.cpu_count() or 1, include_dashboard=False, _temp_dir=temp_dir)
                 except RuntimeError as error:  # e.g. its GCS did not come up; its logs are in temp_dir
                     raise ValueError(f"a local Ray did not start ({temp_dir}): "
                                      f"{' '.join(str(error).split())[:300]}") from None
@@ -128,21 +164,11 @@ def train_command() -> str:
     return found
 
 
-# Starts the training command so that Ctrl-C reaches it (Ray's workers block SIGINT, and a child
-# inherits the mask) and it ends when the worker that started it dies (a killed sweep leaves no run
-# behind that still holds its directory): PR_SET_PDEATHSIG survives the exec. A small launcher
-# rather than a preexec_fn, which is not safe in a process with threads such as a Ray worker.
-_LAUNCHER = ("import ctypes, os, signal, sys\n"
-             "signal.signal(signal.SIGINT, signal.SIG_DFL)\n"
-             "signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})\n"
-             "ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)\n"  # 1: PR_SET_PDEATHSIG
-             "if os.getppid() != int(sys.argv[1]):\n    sys.exit(137)\n"  # the worker died before the prctl
-             "os.execv(sys.argv[2], sys.argv[2:])\n")
-
-
 def launch_command(argv: list) -> list:
-    """The command line that runs robostrich-train with ``argv`` under the launcher."""
-    return [sys.executable, "-c", _LAUNCHER, str(os.getpid()), train_command(), *argv]
+    """The command line that runs robostrich-train with ``argv`` under the launcher
+    (agents/robostrich/run_launcher.py: Ctrl-C reaches the run, and the run writes its checkpoint
+    and ends when the worker that started it dies)."""
+    return [sys.executable, LAUNCHER, str(os.getpid()), train_command(), *argv]
 
 
 def last_error(log_path: str) -> str:
@@ -176,6 +202,23 @@ def _wait(process) -> int:
             continue
 
 
+def _wait_until_unlocked(run_dir: str) -> None:
+    """Wait (at most INTERRUPT_GRACE_S) while an earlier robostrich-train still holds the run's
+    directory: a sweep started again at once after a killed one finds its runs still writing their
+    checkpoints. Only waits: the run's own lock is what refuses a directory in use."""
+    import fcntl
+    path = os.path.join(run_dir, ".lock")
+    deadline = time.time() + INTERRUPT_GRACE_S
+    while os.path.exists(path) and time.time() < deadline:
+        with open(path, "rb") as handle:
+            try:
+                fcntl.flock(handle, fcntl.LOCK_SH | fcntl.LOCK_NB)
+            except BlockingIOError:
+                time.sleep(0.2)
+                continue
+        return
+
+
 def train_run(argv: list, run_dir: str) -> dict:
     """One robostrich-train command (a Ray task): its output in RUN_DIR/train.log (appended, so a
     resumed run's follows the earlier one's), Ctrl-C or a cancel forwarded so that it writes its
@@ -184,6 +227,7 @@ def train_run(argv: list, run_dir: str) -> dict:
     log_path = os.path.join(run_dir, "train.log")
     env = {**os.environ, "XLA_FLAGS": f"{os.environ.get('XLA_FLAGS', '')} {ONE_THREAD_XLA}".strip()}
     env.pop("RAY_AUTH_TOKEN", None)  # the cluster's, not the training's
+    _wait_until_unlocked(run_dir)
     start = time.time()
     with open(log_path, "ab") as log:
         process = subprocess.Popen(launch_command(argv), stdout=log, stderr=subprocess.STDOUT, env=env)

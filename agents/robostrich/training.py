@@ -24,7 +24,7 @@ from typing import Optional
 
 import numpy as np
 
-from agents.robostrich import evaluation
+from agents.robostrich import directory_lock, evaluation
 from agents.curriculum import Lesson, LessonSettings, format_plan, read_records, run_files
 from agents.robostrich.runs import DEFAULT_LESSONS, DomainRun, check_lesson_names, parse_plan, run_identity
 from agents.robostrich.domains import Domain
@@ -408,26 +408,9 @@ def plan_from_args(args):
 
 
 def lock_run_directory(out: str):
-    """Make ``out`` this run's (an exclusive flock on ``out/.lock``, held while the returned file
-    stays open): two runs writing one directory would interleave their records and overwrite each
-    other's checkpoints. A directory in use is a ValueError that changes nothing."""
-    import fcntl
-    os.makedirs(out, exist_ok=True)
-    path = os.path.join(out, ".lock")
-    handle = open(path, "a+")
-    try:
-        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        handle.seek(0)
-        owner = handle.read().strip()
-        handle.close()
-        raise ValueError(f"{out} is in use by another robostrich-train ({path} is locked"
-                         f"{', process ' + owner if owner else ''}); wait for it to end or choose another --out") from None
-    handle.seek(0)
-    handle.truncate()
-    handle.write(f"{os.getpid()}\n")
-    handle.flush()
-    return handle
+    """Make ``out`` this run's (agents/robostrich/directory_lock.py), held while the returned file
+    stays open."""
+    return directory_lock.lock_directory(out, "robostrich-train")
 
 
 def _previous_init_path(out: str) -> Optional[str]:
