@@ -90,7 +90,8 @@ def load(domain_name, task_name, task_kwargs=None, environment_kwargs=None, visu
       task_name: e.g. ``"lesson2"``.
       task_kwargs: keyword arguments of the task factory (``random`` seeds it); a
         ``tendon_layout`` may be a built-in layout's name (the layout alone; with its own
-        targets: ``task_kwargs=robostrich_suite.model.layouts.task_kwargs(name)``).
+        targets: ``task_kwargs=robostrich_suite.model.layouts.task_kwargs(name)``) or the
+        path of a layout file (``.json``/``.toml``, ``robostrich-design`` writes them).
       environment_kwargs: keyword arguments of ``dm_control.rl.control.Environment``.
       visualize_reward: accepted for ``dm_control.suite.load`` compatibility; unused.
     """
@@ -104,10 +105,12 @@ def load(domain_name, task_name, task_kwargs=None, environment_kwargs=None, visu
     if task_kwargs is not None and not isinstance(task_kwargs, dict):
         raise TypeError(f"task_kwargs must be a dict of the task's options, got {type(task_kwargs).__name__}")
     task_kwargs = dict(task_kwargs or {})
-    if isinstance(task_kwargs.get("tendon_layout"), str):  # a built-in layout by name
+    if isinstance(task_kwargs.get("tendon_layout"), str):  # a built-in layout by name, or a layout file
         from robostrich_suite.model import layouts
         try:
-            task_kwargs["tendon_layout"] = layouts.build(task_kwargs["tendon_layout"])
+            name = task_kwargs["tendon_layout"]
+            task_kwargs["tendon_layout"] = (layouts.read_file(name)[1] if name.lower().endswith((".json", ".toml"))
+                                            else layouts.build(name))
         except ValueError as error:
             raise ValueError(f"tendon_layout: {error}") from None
     if environment_kwargs is not None:

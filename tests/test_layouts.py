@@ -252,3 +252,38 @@ def test_a_layout_given_by_name_to_load_builds_that_layout_and_anything_else_is_
         robostrich_suite.load("robostrich_a1", "lesson2", task_kwargs={"tendon_layout": "nope"})
     with pytest.raises(TypeError, match="tendon layout must be a TendonLayout, got int"):
         arm.build_arm(layout=3)
+
+
+def test_a_tendons_own_hole_offset_moves_its_holes_and_round_trips_through_a_file(tmp_path):
+    spec = arm.ArmSpec.from_table1()
+    default = layouts.build("ventral_slips")
+    tendons = list(default.tendons)
+    tendons[1] = arm.TendonSpec(tendons[1].name, "ventral", tendons[1].links, tendons[1].on_base, hole_offset=0.025)
+    mine = arm.TendonLayout(tuple(tendons))
+    path = tmp_path / "mine.json"
+    path.write_text(json.dumps(layouts.to_dict(mine, "mine")))
+    assert layouts.read_file(path)[1] == mine
+    from dm_control import mjcf
+    physics = mjcf.Physics.from_mjcf_model(arm.build_arm(spec, mine))
+    own = arm.hole_site_name("c17", "ventral", tendons[1].name)
+    assert physics.named.model.site_pos[own][0] == pytest.approx(0.025)
+    assert physics.named.model.site_pos[arm.hole_site_name("c17", "ventral")][0] == pytest.approx(spec.hole_offset)
+    # A longer moment arm: the same joint bend shortens the tendon more, so its servo's range grows.
+    ranges = physics.named.model.actuator_ctrlrange
+    before = mjcf.Physics.from_mjcf_model(arm.build_arm(spec, default)).named.model.actuator_ctrlrange
+    assert ranges[tendons[1].name][1] > before[tendons[1].name][1]
+    assert xml(layouts.build("ventral_slips")) == xml(arm.TendonLayout(tuple(
+        arm.TendonSpec(t.name, t.side, t.links, t.on_base, hole_offset=None) for t in default.tendons)))
+
+
+@pytest.mark.parametrize("bad", [0.5, 0.001, "x", True, None, float("inf")])
+def test_a_hole_offset_out_of_range_names_the_file_and_the_tendon(bad, tmp_path):
+    data = layouts.to_dict(layouts.build("ventral_slips"), "mine")
+    data["tendons"][2]["hole_offset"] = bad
+    path = tmp_path / "mine.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(layouts.LayoutFileError, match=r"mine\.json: tendon 3 \('ventral_c14'\): 'hole_offset' must be"):
+        layouts.read_file(path)
+    with pytest.raises(ValueError, match="hole_offset"):
+        arm.TendonLayout((arm.TendonSpec("d", "dorsal", ("c18", "atlas"), hole_offset=0.1),)).validate(
+            arm.ArmSpec.from_table1())

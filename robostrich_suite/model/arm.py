@@ -43,6 +43,10 @@ COLLISION_TYPE = 2  # contype of arm geoms; obstacles the arm may touch set this
 # The arm's own bit: its links collide with each other (as vertebrae do), and with nothing
 # else that does not set COLLISION_TYPE in its conaffinity.
 SELF_COLLISION_TYPE = 4
+# m: a tendon's own hole offset (moment arm) stays between a hole just outside the 8 mm
+# vertebra's axis and a process about twice the default 15 mm: the paper's arm is
+# 3-D printed at this scale, and a farther hole would stand off links 7-44 mm long.
+HOLE_OFFSET_RANGE = (0.004, 0.04)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -175,11 +179,20 @@ class TendonSpec:
     neck muscle running between two vertebrae (the servo is an idealised
     length actuator of that stretch).  Either way a tendon needs at least two
     holes.
+
+    ``hole_offset`` (m) is this tendon's own distance of its holes (and anchor) from the
+    joint axis line, its moment arm about every joint it crosses; None keeps the arm's
+    ``ArmSpec.hole_offset``.  It is bounded by :data:`HOLE_OFFSET_RANGE`.
     """
     name: str
     side: str
     links: tuple[str, ...]
     on_base: bool = True
+    hole_offset: float | None = None
+
+    def offset(self, spec: "ArmSpec") -> float:
+        """The distance of this tendon's holes from the joint axis line (m)."""
+        return spec.hole_offset if self.hole_offset is None else float(self.hole_offset)
 
     @property
     def insertion(self) -> str:
@@ -283,14 +296,22 @@ class TendonLayout:
                 if link not in order:
                     raise ValueError(f"tendon {tendon.name!r} runs through unknown link {link!r}; "
                                      f"links are {list(spec.joint_names)}")
+            if tendon.hole_offset is not None:
+                low, high = HOLE_OFFSET_RANGE
+                if (isinstance(tendon.hole_offset, bool) or not isinstance(tendon.hole_offset, (int, float))
+                        or not np.isfinite(tendon.hole_offset) or not low <= tendon.hole_offset <= high):
+                    raise ValueError(f"tendon {tendon.name!r}: hole_offset {tendon.hole_offset!r} must be a "
+                                     f"distance from {low} to {high} m")
             ranks = [order[link] for link in tendon.links]
             if any(b <= a for a, b in zip(ranks, ranks[1:])):
                 raise ValueError(f"tendon {tendon.name!r}: links {list(tendon.links)} must run "
                                  "from caudal to cranial without repeats")
 
 
-def hole_site_name(link: str, side: str) -> str:
-    return f"{link}_{side}_hole"
+def hole_site_name(link: str, side: str, tendon: str | None = None) -> str:
+    """The hole of ``link`` on ``side`` (shared by the tendons at the arm's hole offset), or
+    ``tendon``'s own hole there; every hole's name ends in ``_{side}_hole``."""
+    return f"{link}_{side}_hole" if tendon is None else f"{tendon}_at_{link}_{side}_hole"
 
 
 def _anchor_site_name(tendon: str) -> str:
@@ -321,8 +342,8 @@ def build_arm(spec: ArmSpec | None = None, layout: TendonLayout | None = None) -
              pos=[0, 0, -spec.anchor_depth - 0.005], contype=COLLISION_TYPE, conaffinity=0,
              rgba=[0.3, 0.3, 0.3, 1], mass=0.05)
     side_x = {"dorsal": -spec.hole_offset, "ventral": spec.hole_offset}
-    _add_chain(model, base, spec, side_x)
-    _add_tendons(model, base, spec, layout, side_x)
+    bodies = _add_chain(model, base, spec, side_x)
+    _add_tendons(model, base, spec, layout, bodies)
     _exclude_touching_links(model, spec)
     _add_tendon_servos(model, spec, layout)
     return model
@@ -348,12 +369,13 @@ def _add_defaults(model: mjcf.RootElement, spec: ArmSpec) -> None:
         forcerange=[-spec.tendon_max_force, 0.0])
 
 
-def _add_chain(model: mjcf.RootElement, base, spec: ArmSpec, side_x: dict) -> None:
-    """The links, caudal -> cranial (the base link's joint at the base origin), with their holes and the head site."""
+def _add_chain(model: mjcf.RootElement, base, spec: ArmSpec, side_x: dict) -> dict:
+    """The links, caudal -> cranial (the base link's joint at the base origin), with their holes and the head site;
+    returns {link: (body, length)} for the tendons' own holes."""
     joint_range = dict(zip(spec.joint_names, spec.joint_range_rad()))
     masses = dict(zip(spec.joint_names, spec.masses))
     lengths = dict(zip(spec.joint_names[1:], spec.link_lengths))
-    parent, pos = base, 0.0
+    parent, pos, bodies = base, 0.0, {}
     for name in reversed(spec.joint_names):
         body = parent.add("body", name=name, pos=[0, 0, pos], childclass="link")
         body.add("joint", name=name, range=joint_range[name])
@@ -371,22 +393,30 @@ def _add_chain(model: mjcf.RootElement, base, spec: ArmSpec, side_x: dict) -> No
         for side in SIDES:
             body.add("site", name=hole_site_name(name, side),
                      pos=[side_x[side], 0, spec.hole_fraction * length])
-        parent, pos = body, length
+        parent, pos, bodies[name] = body, length, (body, length)
+    return bodies
 
 
-def _add_tendons(model: mjcf.RootElement, base, spec: ArmSpec, layout: TendonLayout, side_x: dict) -> None:
-    """Each tendon from its anchor on the base (if it starts there) through its links' holes."""
+def _add_tendons(model: mjcf.RootElement, base, spec: ArmSpec, layout: TendonLayout, bodies: dict) -> None:
+    """Each tendon from its anchor on the base (if it starts there) through its links' holes:
+    the shared holes, or the tendon's own at its ``hole_offset``."""
     for tendon in layout.tendons:
+        x = tendon.offset(spec) * (1.0 if tendon.side == "ventral" else -1.0)
+        own = tendon.hole_offset is not None and tendon.offset(spec) != spec.hole_offset
         element = model.tendon.add("spatial", name=tendon.name, dclass="tendon",
                                    rgba=[0.1, 0.5, 0.9, 1] if tendon.side == "ventral"
                                    else [0.9, 0.2, 0.2, 1])
         if tendon.on_base:
             anchor = base.add("site", name=_anchor_site_name(tendon.name),
-                              pos=[side_x[tendon.side], 0, -spec.anchor_depth],
+                              pos=[x, 0, -spec.anchor_depth],
                               size=[0.003], rgba=[0.2, 0.7, 0.2, 1])
             element.add("site", site=anchor)
         for link in tendon.links:
-            element.add("site", site=hole_site_name(link, tendon.side))
+            if own:
+                body, length = bodies[link]
+                body.add("site", name=hole_site_name(link, tendon.side, tendon.name),
+                         pos=[x, 0, spec.hole_fraction * length])
+            element.add("site", site=hole_site_name(link, tendon.side, tendon.name if own else None))
 
 
 def _link_geom_radius(spec: ArmSpec, name: str) -> float:

@@ -12,7 +12,9 @@ A user tries another routing without Python in JSON or TOML; each tendon has a
 ``name``, a ``side`` (dorsal or ventral) and either ``links`` (the holes it runs
 through, caudal to cranial; ``on_base`` false ties it at the first one instead of
 an anchor on the base) or ``from``/``to`` (every link between, as
-``TendonSpec.spanning``)::
+``TendonSpec.spanning``), and optionally a ``hole_offset``: its holes' distance from the
+joint axis in metres, its moment arm (default: the arm's 0.015; bounded by
+``arm.HOLE_OFFSET_RANGE``)::
 
     name = "two_dorsal"
     [[tendons]]
@@ -24,6 +26,7 @@ an anchor on the base) or ``from``/``to`` (every link between, as
     name = "ventral_skip"
     side = "ventral"
     links = ["c18", "c12", "c6", "c3"]
+    hole_offset = 0.02
 
 A malformed file raises :class:`LayoutFileError` (a ``ValueError``) naming the
 file, the tendon and what is wrong; a well-formed file describing a bad layout
@@ -33,6 +36,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import pathlib
 from typing import Callable
 
@@ -184,14 +188,15 @@ def task_kwargs(name: str) -> dict:
 
 # --------------------------------------------------------------------------- files
 
-TENDON_KEYS = ("name", "side", "links", "on_base", "from", "to")
+TENDON_KEYS = ("name", "side", "links", "on_base", "from", "to", "hole_offset")
 FILE_KEYS = ("name", "tendons")
 
 
 def to_dict(layout: arm_lib.TendonLayout, name: str | None = None) -> dict:
-    """The declarative form of ``layout`` (explicit ``links``): ``json.dumps`` it to
-    start a file from a built-in."""
-    tendons = [{"name": t.name, "side": t.side, "links": list(t.links), "on_base": t.on_base}
+    """The declarative form of ``layout`` (explicit ``links``; ``hole_offset`` where a tendon
+    has its own): ``json.dumps`` it to start a file from a built-in."""
+    tendons = [{"name": t.name, "side": t.side, "links": list(t.links), "on_base": t.on_base,
+                **({} if t.hole_offset is None else {"hole_offset": float(t.hole_offset)})}
                for t in layout.tendons]
     return {"name": name, "tendons": tendons} if name else {"tendons": tendons}
 
@@ -227,6 +232,13 @@ def from_dict(data, spec: arm_lib.ArmSpec | None = None, source: str = "layout"
         for key in ("name", "side"):
             if not isinstance(entry.get(key), str):
                 fail(f"{label}: '{key}' must be a string, got {entry.get(key)!r}")
+        hole_offset = entry.get("hole_offset")
+        low, high = arm_lib.HOLE_OFFSET_RANGE
+        if "hole_offset" in entry and (isinstance(hole_offset, bool) or not isinstance(hole_offset, (int, float))
+                                       or not math.isfinite(hole_offset) or not low <= hole_offset <= high):
+            fail(f"{label}: 'hole_offset' must be a distance from {low} to {high} m (the holes' distance "
+                 f"from the joint axis), got {hole_offset!r}")
+        hole_offset = None if hole_offset is None else float(hole_offset)
         has_links, has_span = "links" in entry, ("from" in entry or "to" in entry)
         if has_links == has_span:
             fail(f"{label}: give either 'links' (caudal to cranial) or 'from' and 'to'")
@@ -237,7 +249,7 @@ def from_dict(data, spec: arm_lib.ArmSpec | None = None, source: str = "layout"
             on_base = entry.get("on_base", True)
             if not isinstance(on_base, bool):
                 fail(f"{label}: 'on_base' must be true or false, got {on_base!r}")
-            tendons.append(arm_lib.TendonSpec(entry["name"], entry["side"], tuple(links), on_base))
+            tendons.append(arm_lib.TendonSpec(entry["name"], entry["side"], tuple(links), on_base, hole_offset))
         else:
             if "on_base" in entry:
                 fail(f"{label}: 'on_base' goes with 'links'; with 'from' the base link means "
@@ -246,8 +258,9 @@ def from_dict(data, spec: arm_lib.ArmSpec | None = None, source: str = "layout"
                 if not isinstance(entry.get(key), str):
                     fail(f"{label}: '{key}' must be a link name, got {entry.get(key)!r}")
             try:
-                tendons.append(arm_lib.TendonSpec.spanning(entry["name"], entry["side"], entry["to"],
-                                                           spec, origin=entry["from"]))
+                tendons.append(dataclasses.replace(
+                    arm_lib.TendonSpec.spanning(entry["name"], entry["side"], entry["to"], spec, origin=entry["from"]),
+                    hole_offset=hole_offset))
             except ValueError as error:
                 fail(str(error))
     layout = arm_lib.TendonLayout(tuple(tendons))
