@@ -7,13 +7,11 @@ runner with a one-lesson plan.
 import dataclasses
 import json
 import os
-import pickle
-import zlib
 from typing import Callable, ClassVar, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from agents import checkpoint
+from agents import checkpoint, trees
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 
@@ -145,7 +143,7 @@ class TrainingInterrupted(RuntimeError):
 
 def run_files(run_dir: str) -> Tuple[str, str, str]:
     """A run directory's checkpoint, per-episode metrics and periodic evaluations."""
-    return (os.path.join(run_dir, "checkpoint.pkl"), os.path.join(run_dir, "metrics.jsonl"),
+    return (os.path.join(run_dir, checkpoint.FILE_NAME), os.path.join(run_dir, "metrics.jsonl"),
             os.path.join(run_dir, "evals.jsonl"))
 
 
@@ -172,23 +170,31 @@ class CurriculumRun:
     Checkpoints hold the learner state (parameters, optimiser states,
     temperature, update counter, RNG key), the actor's key, the replay buffer
     (filled part) and its sampling RNG, the loop counters, the lesson index and
-    steps into it, and the pickled environment (physics, task RNG and any task
-    state, e.g. lesson 3's carried-over pose), so a resumed run continues
-    bit-exactly, even mid-episode.
+    steps into it, and, given an ``episode_state``, the open episode (simulation
+    state, the model fields the task changed, task RNG and per-episode variables,
+    e.g. lesson 3's carried-over pose), so a resumed run continues bit-exactly,
+    even mid-episode. All of it is data (agents/checkpoint.py), nothing pickled.
     """
 
     def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
                  make_environment: Callable, checkpoint_every: int = 10_000, name: str = "run",
                  lessons: Optional[LessonSettings] = None, residual=None, identity: Optional[dict] = None,
-                 episode_probe: Optional[Callable] = None, keep_lesson_checkpoints: bool = False):
+                 episode_probe: Optional[Callable] = None, keep_lesson_checkpoints: bool = False,
+                 episode_state=None):
         """``make_environment(lesson, seed)`` builds a lesson's environment; ``lessons``, what
         changes with the lesson (default: nothing); ``residual``, a residual policy's (base policy
         factory, scale) (SACBuilder); ``identity``, what the fingerprint holds beside the config,
         lesson settings, plan and seed (the environments' options); ``episode_probe(env)``, the metrics an
         episode's record gets from its last state (SACBuilder.make_components).
         ``keep_lesson_checkpoints`` also writes a checkpoint at the end of every lesson but the
-        last, ``after_lessonK.pkl`` (K lessons done): the policy of the first K lessons."""
+        last, ``after_lessonK.ckpt`` (K lessons done): the policy of the first K lessons.
+        ``episode_state`` stores an environment's open episode as data, for checkpoints: anything with
+        ``model_reference(env)`` (taken when a lesson's environment is made), ``capture(env, timestep,
+        flat_observation, reference)`` and ``restore(env, state, reference) -> (timestep,
+        flat_observation)``, e.g. the domain glue's environment_state module; without one a resumed
+        run starts a fresh episode."""
         self.keep_lesson_checkpoints = bool(keep_lesson_checkpoints)
+        self.episode_state = episode_state
         self.plan = list(plan)
         self.config, self.seed, self.run_dir, self.name = config, seed, run_dir, name
         self.lessons = lessons or LessonSettings()
@@ -204,7 +210,10 @@ class CurriculumRun:
 
     # -- lessons ---------------------------------------------------------------------------
     def _make_lesson_env(self, index):
-        return self.make_environment(self.plan[index], self.seed + 1000 * (index + 1))
+        env = self.make_environment(self.plan[index], self.seed + 1000 * (index + 1))
+        # The environment as made: a checkpoint stores what its episodes changed since.
+        self._model_reference = None if self.episode_state is None else self.episode_state.model_reference(env)
+        return env
 
     def _enter_lesson(self):
         """What the loop changes with the lesson besides the environment: the hindsight share,
@@ -217,7 +226,7 @@ class CurriculumRun:
 
     def lesson_checkpoint_path(self, lessons_done: int) -> str:
         """Where ``keep_lesson_checkpoints`` writes the checkpoint after ``lessons_done`` lessons."""
-        return os.path.join(self.run_dir, f"after_lesson{lessons_done}.pkl")
+        return os.path.join(self.run_dir, checkpoint.LESSON_FILE_NAME.format(lessons_done=lessons_done))
 
     @property
     def total_steps(self) -> int:
@@ -246,21 +255,21 @@ class CurriculumRun:
 
     def state_dict(self) -> dict:
         loop = self.loop
-        env_blob = None
+        environment = None
         try:
-            env_blob = zlib.compress(pickle.dumps(loop.episode_state(), pickle.HIGHEST_PROTOCOL), 1)
-        except Exception as e:  # documented fallback: resume then resets the episode
-            env_blob = None
-            print(f"warning: environment is not picklable ({e}); a resume will start a fresh episode")
+            if self.episode_state is not None:
+                environment = self.episode_state.capture(*loop.episode_state(), self._model_reference)
+        except checkpoint.NotData as e:  # documented fallback: resume then starts a fresh episode
+            print(f"warning: the open episode cannot be stored ({e}); a resume will start a fresh episode")
         return {
-            "learner": loop.learner.get_state(),
+            "learner": trees.to_arrays(loop.learner.get_state()),
             "actor_key": np.asarray(loop.actor.key),
             "actor_noise": None if loop.actor.noise is None else np.asarray(loop.actor.noise),
             "replay": loop.replay.state_dict(),
             "loop": loop.state_dict(),
             "lesson_index": self.lesson_index,
             "lesson_steps": self.lesson_steps,
-            "environment": env_blob,
+            "environment": environment,
             "latest_metrics": loop.metrics_as_floats(),
         }
 
@@ -278,15 +287,24 @@ class CurriculumRun:
         if missing:
             raise checkpoint.CheckpointError(f"{path} lacks the run state {missing} (not written by a CurriculumRun)")
         loop = self.loop
-        loop.learner.set_state(state["learner"])
+        try:
+            loop.learner.set_state(trees.rebuild(state["learner"], loop.learner.state, "the stored learner"))
+        except ValueError as e:
+            raise checkpoint.CheckpointError(f"{path}: {e}") from None
         loop.actor.update(loop.learner.policy_params)
         loop.actor.key = np.asarray(state["actor_key"])
         noise = state["actor_noise"]
         loop.actor.noise = None if noise is None else np.asarray(noise, np.float32)
         loop.replay.load_state_dict(state["replay"])
         self.lesson_index, self.lesson_steps = state["lesson_index"], state["lesson_steps"]
-        if state["environment"] is not None:
-            loop.resume_episode(*pickle.loads(zlib.decompress(state["environment"])))
+        if state["environment"] is not None and self.episode_state is not None:
+            env = self._make_lesson_env(min(self.lesson_index, len(self.plan) - 1))
+            try:
+                episode = self.episode_state.restore(env, state["environment"], self._model_reference)
+            except (ValueError, KeyError, TypeError) as e:
+                raise checkpoint.CheckpointError(f"{path}: its open episode does not fit this run's environment "
+                                                 f"({type(e).__name__}: {e})") from None
+            loop.resume_episode(env, *episode)
         elif not self.done:
             loop.set_environment(self._make_lesson_env(self.lesson_index), close_episode=False)
         self._enter_lesson()

@@ -437,6 +437,15 @@ class ArmPhysicsMixin:
         # environment (a resumed training run) then continues bit-exactly.
         mujoco_lib.mj_step1(self.model.ptr, self.data.ptr)
 
+    def checkpoint_state(self) -> dict:
+        """The variables beside MuJoCo's state that a resumed episode needs (agents/robostrich/environment_state.py)."""
+        return {"divergence": self.divergence, "episodes_started": self.episodes_started,
+                "episodes_diverged": self.episodes_diverged}
+
+    def restore_checkpoint_state(self, state: dict) -> None:
+        self.divergence = None if state["divergence"] is None else str(state["divergence"])
+        self.episodes_started, self.episodes_diverged = int(state["episodes_started"]), int(state["episodes_diverged"])
+
     # The arm's state when the last reset began, (qpos, qvel, act, tendon command), or None if
     # the episode it ended diverged: a "continue" episode starts from it (``Reach``). Kept here,
     # once per reset, so that no task has to copy the state after every step in case it is the

@@ -62,14 +62,14 @@ def trained(tmp_path_factory):
 def test_train_exits_zero_and_writes_its_run(trained):
     result, out = trained
     assert_succeeded(result)
-    for name in ("config.json", "summary.json", "curriculum/checkpoint.pkl", "evaluation/curriculum_heldout.json"):
+    for name in ("config.json", "summary.json", "curriculum/checkpoint.ckpt", "evaluation/curriculum_heldout.json"):
         assert (out / name).stat().st_size > 0, name
     assert '"curriculum"' in result.stdout  # the summary goes to stdout, not a dump to stderr
 
 
 def test_evaluate_exits_zero_on_a_checkpoint(trained, tmp_path):
     _, out = trained
-    result = call("robostrich-evaluate", out / "curriculum" / "checkpoint.pkl", "--out", tmp_path / "ev",
+    result = call("robostrich-evaluate", out / "curriculum" / "checkpoint.ckpt", "--out", tmp_path / "ev",
                   "--num-targets", "1", "--no-rerun", "--no-figures")
     assert_succeeded(result)
     assert (tmp_path / "ev" / "summary.json").stat().st_size > 0
@@ -118,16 +118,16 @@ def test_the_other_scripts_exit_zero(tmp_path):
 def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     empty = tmp_path / "empty_run"
     empty.mkdir()
-    checkpoint.save(str(tmp_path / "whole.pkl"), {"weights": list(range(2000))}, {"seed": 0})
-    data = (tmp_path / "whole.pkl").read_bytes()
-    (tmp_path / "truncated.pkl").write_bytes(data[:len(data) // 2])
-    (tmp_path / "empty.pkl").write_bytes(b"")
+    checkpoint.save(str(tmp_path / "whole.ckpt"), {"weights": list(range(2000))}, {"seed": 0})
+    data = (tmp_path / "whole.ckpt").read_bytes()
+    (tmp_path / "truncated.ckpt").write_bytes(data[:len(data) // 2])
+    (tmp_path / "empty.ckpt").write_bytes(b"")
     cases = {  # side by side: each only parses, imports and checks
         "resume_empty": start("robostrich-train", "--resume", "--quiet", "--out", empty),
         "checkpoint_every_0": start("robostrich-train", "--checkpoint-every", "0", "--out", tmp_path / "ck0"),
-        "truncated": start("robostrich-evaluate", tmp_path / "truncated.pkl", "--num-targets", "1", "--no-rerun",
+        "truncated": start("robostrich-evaluate", tmp_path / "truncated.ckpt", "--num-targets", "1", "--no-rerun",
                            "--no-figures"),
-        "empty": start("robostrich-evaluate", tmp_path / "empty.pkl", "--num-targets", "1"),
+        "empty": start("robostrich-evaluate", tmp_path / "empty.ckpt", "--num-targets", "1"),
         "ramp_negative": start("robostrich-movement", "--ramp-time", "-1", "--out", tmp_path / "mv"),
         "layout": start("robostrich-train", "--layout", "tangled", "--quiet", "--out", tmp_path / "lay"),
         "task": start("robostrich-train", "--plan", "lesson1:10,lesson9:10", "--quiet", "--out", tmp_path / "task"),
@@ -146,8 +146,8 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     assert os.listdir(empty) == []  # nothing started
     assert_user_error(results["checkpoint_every_0"], "--checkpoint-every")
     assert results["checkpoint_every_0"].returncode == 2 and not (tmp_path / "ck0").exists()
-    assert_user_error(results["truncated"], "truncated.pkl", "damaged")
-    assert_user_error(results["empty"], "empty.pkl", "not a SAC checkpoint")
+    assert_user_error(results["truncated"], "truncated.ckpt", "damaged")
+    assert_user_error(results["empty"], "empty.ckpt", "not a SAC checkpoint")
     assert_user_error(results["ramp_negative"], "--ramp-time")
     assert not list(tmp_path.glob("mv/*.rrd"))  # refused before the recording was opened
     assert_user_error(results["layout"], "unknown layout 'tangled'")
@@ -168,13 +168,13 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
 
 
 def test_read_fingerprint_checks_the_file(tmp_path):
-    path = tmp_path / "c.pkl"
+    path = tmp_path / "c.ckpt"
     checkpoint.save(str(path), {"x": 1}, {"seed": 3})
     assert checkpoint.read_fingerprint(str(path)) == {"seed": 3}
     data = path.read_bytes()
     for damaged in (b"", data[:20], data[:-1], data[:-1] + bytes([data[-1] ^ 1])):
         path.write_bytes(damaged)
-        with pytest.raises(checkpoint.CheckpointError, match="c.pkl"):
+        with pytest.raises(checkpoint.CheckpointError, match="c.ckpt"):
             checkpoint.read_fingerprint(str(path))
 
 

@@ -65,7 +65,7 @@ def test_resumed_her_run_is_bit_exact(tmp_path):
     a = DomainRun(plan, HER, seed=3, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
     with pytest.raises(TrainingInterrupted):
         a.run(stop_at_step=740)  # mid-episode in lesson 2, after learning started
-    path = str(tmp_path / "ckpt.pkl")
+    path = str(tmp_path / "run.ckpt")
     a.save_checkpoint(path)
     b = DomainRun(plan, HER, seed=3, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
     b.restore(path)
@@ -88,7 +88,7 @@ def test_task_kwargs_reach_every_lesson_and_the_checkpoint_fingerprint(tmp_path)
     assert run.loop.env.task.weights.position_error == 10.0
     run.run()
     assert run.done
-    path = str(tmp_path / "ckpt.pkl")
+    path = str(tmp_path / "run.ckpt")
     run.save_checkpoint(path)
     plain = DomainRun(plan, HER, seed=0, run_dir=str(tmp_path / "b"))
     assert plain.loop.env.task.weights.position_error == 2.0
@@ -115,7 +115,7 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
 
     assert relabelled_share(run.loop.her_ratio) == 0.0
     assert relabelled_share(lessons.her_ratio("lesson1", config)) > 0.3  # what lesson 1 sampled
-    path = str(tmp_path / "ckpt.pkl")
+    path = str(tmp_path / "run.ckpt")
     run.save_checkpoint(path)
     resumed = DomainRun(plan, config, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000, lessons=lessons)
     assert resumed.loop.her_ratio == 0.5  # lesson 1 until the checkpoint says otherwise

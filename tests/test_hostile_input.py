@@ -76,8 +76,8 @@ FLAG_CASES = {  # (command, arguments, fragments the one line must hold)
     "hidden_letters": ("robostrich-train", ["--hidden-sizes", "a,b"], ["--hidden-sizes", "'a,b'"]),
     "her_lessons_typo": ("robostrich-train", ["--her-lessons", "lesson1,2"], ["--her-lessons", "'2'"]),
     "abbreviated_flag": ("robostrich-train", ["--learning-rat", "1e-3"], ["--learning-rat"]),
-    "evaluate_targets_0": ("robostrich-evaluate", ["x.pkl", "--num-targets", "0"], ["--num-targets"]),
-    "evaluate_targets_negative": ("robostrich-evaluate", ["x.pkl", "--num-targets", "-3"], ["--num-targets"]),
+    "evaluate_targets_0": ("robostrich-evaluate", ["x.ckpt", "--num-targets", "0"], ["--num-targets"]),
+    "evaluate_targets_negative": ("robostrich-evaluate", ["x.ckpt", "--num-targets", "-3"], ["--num-targets"]),
     "targets_nan": ("robostrich-targets", ["--seek-level-time", "nan", "--out", "t.npz"], ["--seek-level-time"]),
     "movement_nan": ("robostrich-movement", ["--amplitude", "nan"], ["--amplitude"]),
     "movement_inf": ("robostrich-movement", ["--ramp-time", "inf"], ["--ramp-time"]),
@@ -153,7 +153,7 @@ def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
     assert json.loads((out / "config.json").read_text())["seed"] == 0  # the second run touched nothing
     steps = {}
     for label in ("curriculum", "baseline"):
-        record = checkpoint._read_record(str(out / label / "checkpoint.pkl"))
+        record = checkpoint._read_record(str(out / label / "checkpoint.ckpt"))
         steps[label] = record["payload"]["loop"]["env_steps"]
         assert 0 < steps[label] <= 5800, steps
     assert steps["curriculum"] < 5800 or steps["baseline"] < 5800  # stopped early, not at the plan's end
@@ -161,7 +161,7 @@ def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
     missing = tmp_path / "missing"  # checkpoints with a valid checksum but no learner: a worker's one line
     shutil.copytree(out, missing)
     for label in ("curriculum", "baseline"):
-        path = missing / label / "checkpoint.pkl"
+        path = missing / label / "checkpoint.ckpt"
         record = checkpoint._read_record(str(path))
         checkpoint.save(str(path), {k: v for k, v in record["payload"].items() if k != "learner"},
                         record["fingerprint"])
@@ -174,7 +174,7 @@ def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
     records = [json.loads(line) for line in torn.read_text().splitlines()]
     assert sum(r["length"] for r in records) == 5800 and records[-1]["env_steps"] == 5800, records
     assert [r["env_steps"] for r in records if r.get("cut")] == [2900, 5800]  # each lesson's last episode, cut
-    one_line_error(finish(rejected), "checkpoint.pkl", "learner")
+    one_line_error(finish(rejected), "checkpoint.ckpt", "learner")
 
 
 def test_incomplete_checkpoints_and_task_names_are_refused_before_any_work(tmp_path):
@@ -182,16 +182,16 @@ def test_incomplete_checkpoints_and_task_names_are_refused_before_any_work(tmp_p
     from agents.curriculum import LessonSettings
     fingerprint = {"plan": "robostrich/lesson1:300,robostrich/lesson2:300", "config": SACConfig().to_dict(),
                    "lessons": LessonSettings().to_dict(), "seed": 0, "observation_layout": [], "action_size": 9}
-    empty, whole = tmp_path / "empty.pkl", tmp_path / "whole.pkl"
+    empty, whole = tmp_path / "empty.ckpt", tmp_path / "whole.ckpt"
     checkpoint.save(str(empty), {}, fingerprint)
     checkpoint.save(str(whole), {k: None for k in ("learner", "actor_key", "actor_noise", "replay", "loop",
                                                    "lesson_index", "lesson_steps", "environment",
                                                    "latest_metrics")}, fingerprint)
-    checkpoint.save(str(tmp_path / "no_plan.pkl"), {}, {"seed": 0})
+    checkpoint.save(str(tmp_path / "no_plan.ckpt"), {}, {"seed": 0})
     cases = {
-        "evaluate": (start("robostrich-evaluate", empty, "--out", tmp_path / "e"), ["empty.pkl", "learner"]),
-        "no_plan": (start("robostrich-evaluate", tmp_path / "no_plan.pkl", "--out", tmp_path / "e"),
-                    ["no_plan.pkl", "plan"]),
+        "evaluate": (start("robostrich-evaluate", empty, "--out", tmp_path / "e"), ["empty.ckpt", "learner"]),
+        "no_plan": (start("robostrich-evaluate", tmp_path / "no_plan.ckpt", "--out", tmp_path / "e"),
+                    ["no_plan.ckpt", "plan"]),
         "init_from": (start("robostrich-train", *TRAIN, "--init-from", empty, "--out", tmp_path / "i"),
                       ["--init-from", "learner"]),
         "track": (start("robostrich-evaluate", whole, "--track-task", "nope", "--out", tmp_path / "e"),
@@ -247,7 +247,7 @@ def test_sigterm_is_handled_as_ctrl_c_checkpoint_written_and_143(tmp_path):
     assert result.returncode == 143, result.stderr[-3000:]
     line = result.stderr.strip().splitlines()[-1]
     assert line.startswith("robostrich-train: terminated (checkpoint written at step"), result.stderr[-3000:]
-    steps = checkpoint._read_record(str(out / "curriculum" / "checkpoint.pkl"))["payload"]["loop"]["env_steps"]
+    steps = checkpoint._read_record(str(out / "curriculum" / "checkpoint.ckpt"))["payload"]["loop"]["env_steps"]
     assert 0 < steps < 5800
 
 

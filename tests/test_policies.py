@@ -64,7 +64,7 @@ def test_exported_policy_acts_as_its_runs_evaluation_actor(tmp_path):
                         checkpoint_every=300)
     run.run()
     path = tmp_path / "policy.npz"
-    policy = export_policy(str(tmp_path / "run" / "checkpoint.pkl"), str(path), command="a test")
+    policy = export_policy(str(tmp_path / "run" / "checkpoint.ckpt"), str(path), command="a test")
     again = policies.read_policy(path)
     assert again.info["seed"] == 3 and again.info["command"] == "a test"
     assert again.info["layout"] == layouts.DEFAULT

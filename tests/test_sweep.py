@@ -27,7 +27,7 @@ TINY = ["--plan", "lesson1:100,lesson2:100,lesson3:100", "--hidden-sizes", "16,1
         "--min-replay-size", "20", "--num-eval-targets", "1", "--final-eval-targets", "1", "--eval-every", "1000000",
         "--checkpoint-every", "100", "--no-baseline", "--track-task", "", "--no-rerun", "--no-figures"]
 GRID = ["--seeds", "0,1", "--layouts", "ventral_slips,antagonist_pairs", "--num-cpus", "2", "--quiet", *TINY]
-CHECKPOINT = "checkpoint.pkl"  # a run's checkpoint, in RUN/curriculum/
+CHECKPOINT = "checkpoint.ckpt"  # a run's checkpoint, in RUN/curriculum/
 RUNS = [(layout, seed) for layout in ("ventral_slips", "antagonist_pairs") for seed in (0, 1)]
 
 
@@ -159,7 +159,7 @@ def test_a_two_by_two_sweep_finishes_and_its_table_aggregates_the_runs(finished_
         assert group["aggregate"]["results"] == sweep_table.aggregate(summaries, [0, 1])["results"]
         successes = [s["runs"]["curriculum"]["heldout"]["success_rate"] for s in summaries]
         assert group["aggregate"]["results"]["curriculum"]["heldout"]["success_rate"]["values"] == successes
-        assert all((d / "curriculum" / "checkpoint.pkl").exists() for d in dirs)
+        assert all((d / "curriculum" / CHECKPOINT).exists() for d in dirs)
     markdown = (out / "sweep.md").read_text()
     assert markdown == result.stdout and "4 of 4 runs finished, 0 failed" in markdown
     assert "## ventral_slips" in markdown and "## antagonist_pairs" in markdown

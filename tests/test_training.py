@@ -45,7 +45,7 @@ def test_checkpoint_round_trips_bit_exactly_and_continues_identically(tmp_path):
     with pytest.raises(TrainingInterrupted):
         a.run(stop_at_step=450)  # mid-episode, after learning started
     assert a.loop.learner.num_updates > 0
-    path = str(tmp_path / "ckpt.pkl")
+    path = str(tmp_path / "run.ckpt")
     a.save_checkpoint(path)
     b = DomainRun(plan, TINY, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
     b.restore(path)
@@ -65,12 +65,12 @@ def test_killed_and_resumed_run_matches_an_uninterrupted_one(tmp_path):
     with pytest.raises(ValueError, match="--resume"):
         training.main(args + ["--out", killed])  # never silently restarts over a checkpoint
     training.main(args + ["--out", killed, "--resume"])
-    fp = checkpoint.read_fingerprint(os.path.join(whole, "curriculum", "checkpoint.pkl"))
-    a, b = (checkpoint.load(os.path.join(d, "curriculum", "checkpoint.pkl"), fp) for d in (whole, killed))
+    fp = checkpoint.read_fingerprint(os.path.join(whole, "curriculum", "checkpoint.ckpt"))
+    a, b = (checkpoint.load(os.path.join(d, "curriculum", "checkpoint.ckpt"), fp) for d in (whole, killed))
     assert a["loop"]["env_steps"] == b["loop"]["env_steps"] == 1200
     assert a["loop"]["transitions"] == b["loop"]["transitions"] == 600  # action repeat 2
     assert (a["lesson_index"], a["lesson_steps"]) == (b["lesson_index"], b["lesson_steps"]) == (2, 0)
-    assert int(a["learner"].steps) == int(b["learner"].steps) > 0
+    assert int(a["learner"][".steps"]) == int(b["learner"][".steps"]) > 0
     for x, y in zip(leaves(a["learner"]), leaves(b["learner"]), strict=True):
         np.testing.assert_array_equal(x, y)
     for name in ("metrics.jsonl", "evals.jsonl"):  # no duplicated records after the resume
@@ -91,7 +91,7 @@ def test_mismatched_or_damaged_checkpoint_raises(tmp_path):
         c.restore(a.checkpoint_path)
     data = bytearray(open(a.checkpoint_path, "rb").read())
     data[len(data) // 2] ^= 0xFF
-    damaged = str(tmp_path / "damaged.pkl")
+    damaged = str(tmp_path / "damaged.ckpt")
     open(damaged, "wb").write(bytes(data))
     d = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "d"))
     with pytest.raises(ValueError, match="damaged"):
@@ -101,29 +101,18 @@ def test_mismatched_or_damaged_checkpoint_raises(tmp_path):
         d.restore(damaged)
 
 
-def test_checkpoint_of_another_format_version_or_missing_a_field_is_refused_in_one_line(tmp_path):
-    """A checkpoint written by an older format (here version 1, its checksum intact) is refused with
-    one line naming its version and the one this code reads; a fingerprint without a config field
-    (written before the field existed) is refused naming the field, not filled in."""
-    import hashlib
-    import pickle
+def test_checkpoint_whose_fingerprint_lacks_a_field_is_refused_naming_it(tmp_path):
+    """A fingerprint without a config field (written before the field existed) is refused naming
+    the field, not filled in; the run's own checkpoint restores."""
     plan = parse_plan("point_mass/easy:300")
     run = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300)
     run.run()
     payload = checkpoint.load(run.checkpoint_path)
-    body = pickle.dumps({"format_version": 1, "fingerprint": run.fingerprint(), "payload": payload})
-    old = tmp_path / "v1.pkl"
-    old.write_bytes(checkpoint.MAGIC + hashlib.sha256(body).digest() + body)
-    with pytest.raises(checkpoint.CheckpointError) as refused:
-        DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "b")).restore(str(old))
-    message = str(refused.value)
-    assert "format version 1" in message and f"reads version {checkpoint.FORMAT_VERSION}" in message
-    assert "\n" not in message and checkpoint.FORMAT_VERSION == 2
     lacking = run.fingerprint()
     lacking["config"] = {k: v for k, v in lacking["config"].items() if k != "her_ratio"}
-    checkpoint.save(str(tmp_path / "lacking.pkl"), payload, lacking)
+    checkpoint.save(str(tmp_path / "lacking.ckpt"), payload, lacking)
     with pytest.raises(ValueError, match=r"her_ratio: checkpoint has '<missing>'"):
-        DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "c")).restore(str(tmp_path / "lacking.pkl"))
+        DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "c")).restore(str(tmp_path / "lacking.ckpt"))
     DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "d")).restore(run.checkpoint_path)  # its own: fine
 
 
@@ -176,8 +165,8 @@ def test_runs_trained_in_worker_processes_equal_runs_trained_in_turn(tmp_path):
     assert summaries["1"]["runs"] == summaries["2"]["runs"]
     assert summaries["1"]["updates"] == summaries["2"]["updates"] and summaries["2"]["updates"]["baseline"] > 0
     for label in ("curriculum", "baseline"):
-        a = checkpoint.load(str(tmp_path / "1" / label / "checkpoint.pkl"), None)
-        b = checkpoint.load(str(tmp_path / "2" / label / "checkpoint.pkl"), None)
+        a = checkpoint.load(str(tmp_path / "1" / label / "checkpoint.ckpt"), None)
+        b = checkpoint.load(str(tmp_path / "2" / label / "checkpoint.ckpt"), None)
         for x, y in zip(leaves(a["learner"]), leaves(b["learner"]), strict=True):
             np.testing.assert_array_equal(x, y)
 
@@ -201,20 +190,20 @@ def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
 
 
 def test_lesson_checkpoints_hold_the_policy_after_each_lesson(tmp_path):
-    """--keep-lesson-checkpoints writes RUN/after_lessonK.pkl at the end of every lesson but the
+    """--keep-lesson-checkpoints writes RUN/after_lessonK.ckpt at the end of every lesson but the
     last: a whole checkpoint of that moment, which robostrich-evaluate's loader restores."""
     from agents.robostrich import evaluation
     args = TINY_ARGS[:-1] + ["--plan", "point_mass/easy:300,point_mass/hard:300", "--no-baseline",
                              "--checkpoint-every", "1000", "--keep-lesson-checkpoints",
                              "--out", str(tmp_path)]
     training.main(args)
-    kept = tmp_path / "curriculum" / "after_lesson1.pkl"
-    assert sorted(p.name for p in (tmp_path / "curriculum").glob("after_lesson*.pkl")) == [kept.name]
+    kept = tmp_path / "curriculum" / "after_lesson1.ckpt"
+    assert sorted(p.name for p in (tmp_path / "curriculum").glob("after_lesson*.ckpt")) == [kept.name]
     state = checkpoint.load(str(kept), None)
     assert state["lesson_index"] == 1 and state["loop"]["env_steps"] == 300
     run = evaluation.load_run_from_checkpoint(str(kept))
     assert run.loop.env_steps == 300 and run.lesson.task == "hard"
-    final = checkpoint.load(str(tmp_path / "curriculum" / "checkpoint.pkl"), None)
+    final = checkpoint.load(str(tmp_path / "curriculum" / "checkpoint.ckpt"), None)
     assert final["loop"]["env_steps"] == 600
     assert any(not np.array_equal(a, b) for a, b in zip(leaves(state["learner"]), leaves(final["learner"]),
                                                           strict=True))

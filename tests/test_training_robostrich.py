@@ -45,7 +45,7 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
                    "--batch-size", "32", "--min-replay-size", "100", "--checkpoint-every", "300",
                    "--num-eval-targets", "1", "--final-eval-targets", "2", "--quiet"])
     for name in ("config.json", "summary.json", "training.rrd", "figures/learning_curves.png", "figures/track.png",
-                 "curriculum/checkpoint.pkl", "baseline/checkpoint.pkl", "curriculum/metrics.jsonl",
+                 "curriculum/checkpoint.ckpt", "baseline/checkpoint.ckpt", "curriculum/metrics.jsonl",
                  "evaluation/curriculum_heldout.json", "evaluation/baseline_track.json",
                  "evaluation/curriculum_track.rrd", "evaluation/lookup_heldout.json",
                  "evaluation/baseline_heldout_moving.json", "evaluation/lookup_track.json"):
@@ -82,7 +82,7 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
                                        "target_sampling": "failures", "fixed_stored_starts": 0.25}
     assert recorded["lessons"]["her_lessons"] == ["lesson1"]
     assert recorded["config"]["her_ratio"] == 0.5 and recorded["config"]["her_level_goals"] is False
-    reports = evaluation.main([os.path.join(out, "curriculum", "checkpoint.pkl"), "--out", str(tmp_path / "ev"),
+    reports = evaluation.main([os.path.join(out, "curriculum", "checkpoint.ckpt"), "--out", str(tmp_path / "ev"),
                                "--num-targets", "2", "--no-rerun", "--label", "curriculum"])
     for label in ("curriculum", "lookup"):  # deterministic policies, same targets
         assert {k: r["summary"] for k, r in reports[label].items()} == summary[label]

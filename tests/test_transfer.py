@@ -158,10 +158,10 @@ def test_checkpoints_that_cannot_start_the_run_are_refused(source, tmp_path):
     with pytest.raises(transfer.TransferError, match=r"tendon layout 'ventral_slips', this run uses 'antagonist_pairs' \(pass --layout ventral_slips\)"):
         transfer.check_source(path, A1_PLAN, TINY, layout="antagonist_pairs")
     with pytest.raises(FileNotFoundError, match="no checkpoint file"):
-        transfer.check_source(str(tmp_path / "missing.pkl"), A1_PLAN, TINY)
-    (tmp_path / "junk.pkl").write_bytes(b"not a checkpoint")
+        transfer.check_source(str(tmp_path / "missing.ckpt"), A1_PLAN, TINY)
+    (tmp_path / "junk.ckpt").write_bytes(b"not a checkpoint")
     with pytest.raises(checkpoint.CheckpointError):
-        transfer.check_source(str(tmp_path / "junk.pkl"), A1_PLAN, TINY)
+        transfer.check_source(str(tmp_path / "junk.ckpt"), A1_PLAN, TINY)
     fresh = DomainRun(A1_PLAN, TINY, 1, str(tmp_path / "a1"))
     with pytest.raises(transfer.TransferError, match="has changed"):
         transfer.initialize(fresh, path, digest="0" * 64)
@@ -176,20 +176,20 @@ def test_checkpoints_that_cannot_start_the_run_are_refused(source, tmp_path):
 def test_train_from_a_frame_checkpoint_end_to_end(source, tmp_path):
     _, path = source
     out = tmp_path / "a1"
-    bad = start("robostrich-train", "--domain", "robostrich_a1", "--init-from", tmp_path / "nope.pkl",
+    bad = start("robostrich-train", "--domain", "robostrich_a1", "--init-from", tmp_path / "nope.ckpt",
                 "--out", tmp_path / "bad", *TINY_ARGS)
     result = call("robostrich-train", "--domain", "robostrich_a1", "--init-from", path, "--steps", "600",
                   "--workers", "1", "--out", out, *TINY_ARGS)  # the source's layout, the default
     assert_succeeded(result)
-    assert_user_error(finish(bad), "--init-from: no checkpoint file", "nope.pkl")
+    assert_user_error(finish(bad), "--init-from: no checkpoint file", "nope.ckpt")
     assert not (tmp_path / "bad").exists()
     digest = open(path, "rb").read(40)[8:].hex()
-    curriculum = checkpoint.read_fingerprint(str(out / "curriculum" / "checkpoint.pkl"))
+    curriculum = checkpoint.read_fingerprint(str(out / "curriculum" / "checkpoint.ckpt"))
     assert curriculum["init_from"] == digest and curriculum["plan"].count("robostrich_a1/") == 4
-    assert "init_from" not in checkpoint.read_fingerprint(str(out / "baseline" / "checkpoint.pkl"))
+    assert "init_from" not in checkpoint.read_fingerprint(str(out / "baseline" / "checkpoint.ckpt"))
     assert json.loads((out / "config.json").read_text())["init_from"]["sha256"] == digest
     # A resume must come from the same checkpoint; another one is refused before anything is touched.
-    other = call("robostrich-train", "--domain", "robostrich_a1", "--init-from", out / "baseline" / "checkpoint.pkl",
+    other = call("robostrich-train", "--domain", "robostrich_a1", "--init-from", out / "baseline" / "checkpoint.ckpt",
                  "--steps", "600", "--out", out, "--resume", *TINY_ARGS)
     assert_user_error(other, "did not start from --init-from")
 

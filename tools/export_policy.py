@@ -1,6 +1,6 @@
 """Write a trained run's policy as a package policy file (robostrich_suite/policies.py).
 
-    python tools/export_policy.py runs/main/curriculum/checkpoint.pkl \
+    python tools/export_policy.py runs/main/curriculum/checkpoint.ckpt \
         --out robostrich_suite/data/policies/robostrich_curriculum.npz \
         --command "robostrich-train --seed 2 --out runs/main"
 
@@ -19,7 +19,7 @@ from robostrich_suite import cli as cli_lib  # noqa: E402
 
 def main(argv=None):
     parser = cli_lib.Parser(description=__doc__.splitlines()[0])
-    parser.add_argument("checkpoint", help="checkpoint.pkl written by robostrich-train")
+    parser.add_argument("checkpoint", help="checkpoint.ckpt written by robostrich-train")
     parser.add_argument("--out", required=True, help="policy file to write (.npz)")
     parser.add_argument("--command", default="", help="the training command that made the run (recorded)")
     args = parser.parse_args(argv)

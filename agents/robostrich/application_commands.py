@@ -20,7 +20,7 @@ def _parser(description: str, out: str) -> argparse.ArgumentParser:
     from robostrich_suite import cli as cli_lib
     parser = cli_lib.Parser(description=description)
     parser.add_argument("checkpoint", nargs="?", default=None,
-                        help="checkpoint.pkl of robostrich-train on robostrich_a1 (label 'trained'); "
+                        help="checkpoint.ckpt of robostrich-train on robostrich_a1 (label 'trained'); "
                              "without it only zero input and the lookup run")
     parser.add_argument("--reference", default=None, metavar="CHECKPOINT",
                         help="a second checkpoint to compare (label 'reference'), e.g. lessons 1-3 without lesson 4")

@@ -328,7 +328,7 @@ def load_run_from_checkpoint(path: str):
 def main(argv=None):
     parser = cli_lib.Parser(description="Evaluate a checkpoint (and, on the arm, the lookup baseline): "
                                                  "held-out targets and the track task.")
-    parser.add_argument("checkpoint", help="checkpoint.pkl written by robostrich-train")
+    parser.add_argument("checkpoint", help="checkpoint.ckpt written by robostrich-train")
     parser.add_argument("--out", default=None, help="report directory (default: next to the checkpoint)")
     parser.add_argument("--label", default="eval",
                         help="name of this evaluation in the report files (default: %(default)s)")

@@ -5,7 +5,7 @@ from typing import Callable, Optional, Sequence
 
 from agents import curriculum
 from agents.curriculum import Lesson, LessonSettings
-from agents.robostrich import probes
+from agents.robostrich import environment_state, probes
 from agents.robostrich.domains import as_domain
 from agents.sac.config import SACConfig
 
@@ -103,7 +103,7 @@ class DomainRun(curriculum.CurriculumRun):
         self.residual_scale = float(residual_scale)
         super().__init__(plan, config, seed, run_dir, self._make_lesson_environment, checkpoint_every, name,
                          lessons=lessons, residual=self._residual(plan), episode_probe=probes.episode_metrics,
-                         keep_lesson_checkpoints=keep_lesson_checkpoints)
+                         keep_lesson_checkpoints=keep_lesson_checkpoints, episode_state=environment_state)
 
     def extra_identity(self) -> dict:
         """The task options, the layout and ``init_from`` (which transfer.initialize may set after building)."""

@@ -22,12 +22,13 @@ import os
 import re
 from typing import Optional
 
+from agents import checkpoint
 from robostrich_suite import parsing
 
 GRID_KEYS = ("seeds", "layouts", "train", "settings")
 PER_RUN_FLAGS = ("--seed", "--out", "--resume", "--workers")  # the sweep sets these for each run
 NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
-CHECKPOINTED = ("curriculum", "baseline")  # the run labels of robostrich-train that write checkpoint.pkl
+CHECKPOINTED = ("curriculum", "baseline")  # the run labels of robostrich-train that write a checkpoint
 
 
 @dataclasses.dataclass(frozen=True)
@@ -55,7 +56,7 @@ class Run:
         return os.path.exists(self.summary_path)
 
     def has_checkpoint(self) -> bool:
-        return any(os.path.exists(os.path.join(self.run_dir, label, "checkpoint.pkl")) for label in CHECKPOINTED)
+        return any(os.path.exists(os.path.join(self.run_dir, label, checkpoint.FILE_NAME)) for label in CHECKPOINTED)
 
     def argv(self) -> list:
         """robostrich-train's arguments: one worker (the sweep gives each run one core), no bar of

@@ -5,7 +5,7 @@
 
 Run directory:
     config.json                  the command line and resolved configuration
-    curriculum/, baseline/       checkpoint.pkl, metrics.jsonl (one line per episode), evals.jsonl
+    curriculum/, baseline/       checkpoint.ckpt, metrics.jsonl (one line per episode), evals.jsonl
     evaluation/                  <label>_heldout.json, <label>_heldout_moving.json, <label>_track.json,
                                  <label>_track.rrd; labels curriculum, baseline and (on the arm) lookup
     figures/                     learning_curves.png, track.png
@@ -213,7 +213,7 @@ def _add_run_arguments(run) -> None:
                           "the reconstruction of the paper's routing; antagonist_pairs: the best routing of our own)")
     run.add_argument("--init-from", default=None, metavar="CHECKPOINT",
                      help="start the curriculum's learner (policy, critics, target critics, optimiser states, "
-                          "temperature) from a checkpoint.pkl of robostrich-train on the same domain or, for "
+                          "temperature) from a checkpoint.ckpt of robostrich-train on the same domain or, for "
                           "--domain robostrich_a1, on robostrich (the arm on its frame): its networks are mapped "
                           "onto the a1's observations (agents/robostrich/transfer.py). Same tendon layout and networks "
                           "(--hidden-sizes) required; the replay is not carried (other observations); the plain-SAC "
@@ -241,7 +241,7 @@ def _add_file_arguments(files) -> None:
     files.add_argument("--out", default="runs/default", help="run directory (default: %(default)s)")
     files.add_argument("--resume", action="store_true", help="continue from the checkpoints in --out")
     files.add_argument("--keep-lesson-checkpoints", action="store_true",
-                       help="also keep a checkpoint after every lesson but the last (RUN/after_lessonK.pkl), "
+                       help="also keep a checkpoint after every lesson but the last (RUN/after_lessonK.ckpt), "
                             "e.g. the lesson-3 policy to compare lesson 4 with (robostrich-stabilize --reference)")
     files.add_argument("--checkpoint-every", type=positive_int, default=25_000,
                        help="environment steps between checkpoints (default: %(default)s)")
@@ -713,12 +713,18 @@ def check_run_directory(args, setup: _Setup) -> dict:
     """Refuse a fresh run over checkpoints, a resume of nothing, and a resume of another
     configuration or a damaged file, before anything is built or written; returns the
     curriculum's --init-from (path and content hash), if any."""
-    existing = [l for l in setup.run_plans if os.path.exists(os.path.join(args.out, l, "checkpoint.pkl"))]
+    from agents import checkpoint
+    existing = [l for l in setup.run_plans if os.path.exists(os.path.join(args.out, l, checkpoint.FILE_NAME))]
+    pickled = [os.path.join(l, checkpoint.PICKLED_FILE_NAME) for l in setup.run_plans
+               if os.path.exists(os.path.join(args.out, l, checkpoint.PICKLED_FILE_NAME))]
+    if pickled and not existing:  # neither resumed nor trained over: its checkpoints are another format's
+        raise ValueError(f"{args.out} holds checkpoints written with pickle by an earlier version ({', '.join(pickled)}), "
+                         "which this version does not read; train again in another --out")
     if not args.resume and existing:
         raise ValueError(f"{args.out} already holds checkpoints ({', '.join(existing)}); "
                          "pass --resume to continue them or choose another --out")
     if args.resume and not existing:  # a typo in --out must not quietly start the whole job afresh
-        looked = ", ".join(os.path.join(l, "checkpoint.pkl") for l in setup.run_plans)
+        looked = ", ".join(os.path.join(l, checkpoint.FILE_NAME) for l in setup.run_plans)
         where = (f"{args.out} holds no checkpoint ({looked})" if os.path.isdir(args.out)
                  else f"{args.out} does not exist")
         raise FileNotFoundError(f"--resume: nothing to resume: {where}; check --out, or leave out --resume "
@@ -738,7 +744,7 @@ def _check_resumed(args, setup: _Setup, label: str, init: dict) -> dict:
     """One run's checkpoint against this command line (and its records' lines); the --init-from
     a started curriculum recorded."""
     from agents import checkpoint
-    path = os.path.join(args.out, label, "checkpoint.pkl")
+    path = os.path.join(args.out, label, checkpoint.FILE_NAME)
     stored = checkpoint.read_fingerprint(path)
     if label == "curriculum":  # a started run's learner is in its checkpoint: --init-from may be left out
         if init and stored.get("init_from") != init["init_digest"]:

@@ -27,7 +27,7 @@ from typing import Dict, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from agents import checkpoint
+from agents import checkpoint, trees
 from agents.sac.config import SACConfig
 
 # Config fields that make two networks different functions of their inputs.
@@ -159,6 +159,18 @@ def map_opt_state(opt_state, params: Mapping, obs_map: ObservationMap):
     return opt_state
 
 
+def stored_learner(arrays, fresh, path: str):
+    """The learner state a checkpoint stores (agents/trees.py) on the structure of ``fresh``, this
+    run's learner state, with a policy average where the checkpoint kept one and none where it
+    kept none; the first layers keep the checkpoint's shapes for :func:`transfer_state` to map."""
+    averaged = isinstance(arrays, dict) and any(p.startswith(".average_policy_params") for p in arrays)
+    like = fresh._replace(average_policy_params=fresh.policy_params if averaged else None)
+    try:
+        return trees.rebuild(arrays, like, f"the learner of {path}")
+    except ValueError as error:
+        raise TransferError(f"--init-from: {error}") from None
+
+
 def transfer_state(source, fresh, obs_map: ObservationMap):
     """A TrainingState for the target: `source`'s networks, optimisers and temperature mapped, `fresh`'s
     RNG key and update counter (both TrainingStates, numpy leaves). A target that keeps a policy
@@ -252,7 +264,8 @@ def initialize(run, path: str, digest: Optional[str] = None) -> InitSource:
     obs_map = ObservationMap.between(source.fingerprint["observation_layout"], run.loop.flattener.describe(),
                                      *correspondence(source.domain, target_domain))
     learner = run.loop.learner
-    learner.set_state(transfer_state(record["payload"]["learner"], learner.get_state(), obs_map))
+    fresh = learner.get_state()
+    learner.set_state(transfer_state(stored_learner(record["payload"]["learner"], fresh, path), fresh, obs_map))
     run.loop.actor.update(learner.policy_params)
     run.init_from = source.digest  # into the run's fingerprint: a resume knows where it started
     return source

@@ -193,6 +193,24 @@ class _QuadrupedTaskMixin:
         self._episode_start_xy = physics.trunk_position()[:2]
         self.update_target(physics)
 
+    def checkpoint_state(self) -> dict:
+        """The reaching task's episode variables plus the legs, the trunk height schedule and
+        the episode's start (``reach.Reach.checkpoint_state``)."""
+        schedule = self.height_schedule
+        return {**super().checkpoint_state(), "episode_legs": self.episode_legs,
+                "height_schedule": (schedule.times, schedule.heights),
+                "episode_start_time": self._episode_start_time, "episode_start_xy": self._episode_start_xy}
+
+    def restore_checkpoint_state(self, state: dict) -> None:
+        super().restore_checkpoint_state(state)
+        if state["episode_legs"] not in ("stand", "walk"):
+            raise ValueError(f"unknown stored legs {state['episode_legs']!r}")
+        self.episode_legs = state["episode_legs"]
+        times, heights = state["height_schedule"]
+        self.height_schedule = gait_lib.TrunkHeightSchedule(times, heights)
+        self._episode_start_time = float(state["episode_start_time"])
+        self._episode_start_xy = np.array(state["episode_start_xy"], np.float64)
+
     def episode_time(self, physics) -> float:
         return physics.data.time - self._episode_start_time
 
@@ -301,6 +319,14 @@ class NarrowGap(_QuadrupedTaskMixin, reach.Track):
     def initialize_episode(self, physics):
         self._stopped_at = None
         super().initialize_episode(physics)
+
+    def checkpoint_state(self) -> dict:
+        return {**super().checkpoint_state(), "stopped_at": self._stopped_at}
+
+    def restore_checkpoint_state(self, state: dict) -> None:
+        super().restore_checkpoint_state(state)
+        stopped = state["stopped_at"]
+        self._stopped_at = None if stopped is None else (float(stopped[0]), np.array(stopped[1], np.float64))
 
     def update_target(self, physics) -> None:
         x, z = self.world_targets[self.target_index]

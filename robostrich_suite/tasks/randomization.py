@@ -60,6 +60,21 @@ class Randomizer:
             gain=model.actuator_gainprm[actuators].copy(),
             bias=model.actuator_biasprm[actuators].copy())
 
+    # What ``_remember`` keeps: element ids and their nominal parameters.
+    NOMINAL_FIELDS = ("bodies", "joints", "dofs", "actuators", "mass", "inertia", "stiffness", "damping", "gain",
+                      "bias")
+
+    def checkpoint_state(self) -> dict:
+        """The nominal model remembered at the first draw, as data (the task's checkpoint state): a
+        resumed run scales the same nominal values, not the randomised model it restores."""
+        return {"nominal": self._nominal}
+
+    def restore_checkpoint_state(self, state: dict) -> None:
+        nominal = state["nominal"]
+        if nominal is not None and set(nominal) != set(self.NOMINAL_FIELDS):
+            raise ValueError(f"the stored nominal model has {sorted(nominal)}, not {sorted(self.NOMINAL_FIELDS)}")
+        self._nominal = None if nominal is None else {k: np.array(nominal[k]) for k in self.NOMINAL_FIELDS}
+
     def apply(self, physics, random: np.random.RandomState) -> dict:
         """Draw and set new parameters; returns the scales drawn."""
         if self._nominal is None:

@@ -211,6 +211,30 @@ class Reach(base.Task):
     def next_target(self) -> np.ndarray:
         return self.sampler.draw(self.random, self.initial_state)
 
+    # --- checkpoints ----------------------------------------------------------
+    def checkpoint_state(self) -> dict:
+        """The variables an episode changes, as data, for a checkpoint to resume it exactly
+        (agents/robostrich/environment_state.py stores the RNG beside them); the rest is configuration,
+        which the constructor rebuilds from the task's options."""
+        return {"target_position": self.target_position, "last_reached": self._last_reached,
+                "continues_from_physics": self._continues_from_physics, "action_change": self._action_change,
+                "initial_state": self.initial_state, "sampler": self.sampler.checkpoint_state(),
+                "randomizer": None if self.randomizer is None else self.randomizer.checkpoint_state()}
+
+    def restore_checkpoint_state(self, state: dict) -> None:
+        """Continue from :meth:`checkpoint_state`'s variables (ValueError if they do not fit this task)."""
+        if (state["randomizer"] is None) != (self.randomizer is None):
+            raise ValueError("the stored task state and this task differ in domain randomisation")
+        self.target_position = np.array(state["target_position"], np.float64)
+        self._last_reached = state["last_reached"]
+        self._continues_from_physics = bool(state["continues_from_physics"])
+        self._action_change = float(state["action_change"])
+        self.set_initial_state(state["initial_state"])
+        self.sampler.restore_checkpoint_state(state["sampler"])
+        if self.randomizer is not None:
+            self.randomizer.restore_checkpoint_state(state["randomizer"])
+        self._head_reading = None
+
     def action_spec(self, physics):
         """The tendon contractions (m), named after the tendons; nothing else is actuated."""
         low, high = physics.arm_control_range().T
@@ -381,6 +405,16 @@ class Track(Reach):
 
     def next_target(self) -> np.ndarray:
         return self.targets[self.target_index].copy()
+
+    def checkpoint_state(self) -> dict:
+        return {**super().checkpoint_state(), "target_index": self.target_index, "step": self._step}
+
+    def restore_checkpoint_state(self, state: dict) -> None:
+        super().restore_checkpoint_state(state)
+        index = int(state["target_index"])
+        if not 0 <= index < len(self.targets):
+            raise ValueError(f"the stored target index {index} is not one of this task's {len(self.targets)} targets")
+        self.target_index, self._step = index, int(state["step"])
 
     def after_step(self, physics):
         super().after_step(physics)

@@ -60,6 +60,21 @@ class TargetSampler:
             self.tries[self.index] += 1
             self.failures[self.index] += not reached
 
+    def checkpoint_state(self) -> dict:
+        """The pool, its counts and the last draw, as data (the task's checkpoint state)."""
+        return {"pool": self.pool, "tries": self.tries, "failures": self.failures, "index": self.index}
+
+    def restore_checkpoint_state(self, state: dict) -> None:
+        self.set_pool(state["pool"])
+        counts = [np.array(state[name], np.int64) for name in ("tries", "failures")]
+        if any(c.shape != self.tries.shape for c in counts):
+            raise ValueError("the stored target counts do not fit the stored target pool")
+        self.tries, self.failures = counts
+        index = state["index"]
+        if index is not None and not 0 <= int(index) < len(self.pool):
+            raise ValueError(f"the stored target index {index} is outside the pool of {len(self.pool)}")
+        self.index = None if index is None else int(index)
+
     def draw(self, random, initial_state: str) -> np.ndarray:
         """The next target (a copy), drawn with ``random``."""
         if self.by_failures(initial_state):
