@@ -54,3 +54,17 @@ def test_the_record_of_the_groups_reads_back(tmp_path):
     assert sweep_grid.read_recorded_groups(str(path)) == {}
     path.write_text(json.dumps({"default": ["--steps", "600"]}))
     assert sweep_grid.read_recorded_groups(str(path)) == {"default": ["--steps", "600"]}
+
+
+def test_a_damaged_summary_of_a_finished_run_is_named_in_one_line(tmp_path):
+    """A run counts as finished by its summary.json; one that is torn is named, not a traceback."""
+    pytest.importorskip("ray")
+    processes = {}
+    for name, text in {"torn": '{"runs": {', "deep": "[" * 100_000 + "]" * 100_000}.items():
+        summary = tmp_path / name / "runs" / "default" / "seed_0" / "summary.json"
+        summary.parent.mkdir(parents=True)
+        summary.write_text(text)
+        processes[name] = start("robostrich-sweep", "--seeds", "0", "--out", tmp_path / name, "--steps", "600",
+                                "--quiet")
+    for name, process in processes.items():
+        _one_line(finish(process), str(tmp_path / name / "runs" / "default" / "seed_0" / "summary.json"))

@@ -18,6 +18,7 @@ import sys
 from agents.robostrich import directory_lock, sweep_grid, sweep_ray, sweep_table
 from agents.robostrich import training  # robostrich-train's own parser checks every group's flags
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import parsing
 from robostrich_suite.files import write_text
 from robostrich_suite.model import layouts as model_layouts
 
@@ -160,8 +161,7 @@ def collect(out: str, groups, runs, outcomes: dict, command) -> dict:
         entries.append({"group": run.group, "seed": run.seed, "run_dir": os.path.relpath(run.run_dir, out),
                         "status": status, "error": outcome.get("error") if status != "done" else None})
         if status == "done":
-            with open(run.summary_path) as f:
-                by_group.setdefault(run.group, []).append((run, json.load(f)))
+            by_group.setdefault(run.group, []).append((run, parsing.read_json(run.summary_path)))
     result = {"format": FORMAT, "command": command, "total": len(runs),
               "finished": sum(e["status"] == "done" for e in entries),
               "failed": [e for e in entries if e["status"] == "failed"], "runs": entries, "groups": {}}
@@ -198,6 +198,9 @@ def main(argv=None) -> dict:
     check_recorded_groups(args.out, groups)
     command = [PROG, *(sys.argv[1:] if argv is None else argv)]
     pending = [run for run in runs if not run.finished()]
+    for run in runs:  # a finished run's damaged summary stops the sweep now, not when it tabulates
+        if run.finished():
+            parsing.read_json(run.summary_path)
     print(f"{PROG}: {len(runs) - len(pending)} of {len(runs)} runs finished, {len(pending)} to run "
           f"({sum(r.has_checkpoint() for r in pending)} resumed) in {args.out}", file=sys.stderr, flush=True)
     outcomes = {}

@@ -8,6 +8,8 @@ import json
 import os
 import shlex
 
+from robostrich_suite import parsing
+
 LABELS = ("curriculum", "baseline", "lookup")
 KINDS = ("heldout", "heldout_moving", "track")
 METRICS = (("success_rate", "success rate (%)", 100.0, "{:.1f}"),
@@ -129,8 +131,10 @@ def run_minutes(run_dir: str, summary: dict):
     own timings of its last start (None if neither)."""
     path = os.path.join(run_dir, TIMING_FILE)
     if os.path.exists(path):
-        with open(path) as f:
-            return json.load(f)["minutes"]
+        minutes = parsing.read_json(path)
+        if not isinstance(minutes, dict) or not isinstance(minutes.get("minutes"), (int, float)):
+            raise ValueError(f"{path}: not a timing file of robostrich-sweep (no number 'minutes')")
+        return minutes["minutes"]
     timings = summary.get("timings") or {}
     return sum(t["seconds"] for t in timings.values()) / 60.0 if timings else None
 
