@@ -9,11 +9,12 @@ import numpy as np
 import pytest
 
 import robostrich_suite
-from robostrich_suite.tasks import options, randomization, reach, rewards
+from robostrich_suite.tasks import options, perturbations, randomization, reach, rewards
 
 NESTED = {  # options that are a dict of a class's fields (JSON's form) or an instance of it
     "weights": [f.name for f in dataclasses.fields(rewards.RewardWeights)],
     "randomization": [f.name for f in dataclasses.fields(randomization.DomainRandomization)],
+    "perturbation": [f.name for f in dataclasses.fields(perturbations.Perturbation)],
     "environment_kwargs": list(options.ENVIRONMENT_OPTIONS),
 }
 NUMBERS_WITHOUT_DEFAULT = ("time_limit", "random")  # default None, a number when given

@@ -42,7 +42,7 @@ from robostrich_suite.model import legs
 from robostrich_suite.model import quadruped as quad
 from robostrich_suite import scenes
 from robostrich_suite.tasks import gait as gait_lib
-from robostrich_suite.tasks import options, reach, target_samplers
+from robostrich_suite.tasks import options, perturbations, reach, target_samplers
 
 SETTLE_TIME = 0.2  # s of standing physics before each fresh episode
 LESSON4_TIME_LIMIT = 6.0  # s: stand-in, lowered/raised, back (one height change)
@@ -184,8 +184,10 @@ class _QuadrupedTaskMixin:
             schedule = None  # a standing episode holds the nominal height
         self.height_schedule = schedule or gait_lib.TrunkHeightSchedule()
         continuing = self.initial_state == "continue" and self._continuing_state(physics) is not None
+        if isinstance(self.randomizer, perturbations.Perturber):
+            self._begin_robot(physics)  # its trunk height is known before the quadruped stands
         if not continuing:
-            physics.place_standing(trunk_height=float(self.height_schedule(0.0)))
+            physics.place_standing(trunk_height=float(self.height_schedule(0.0)) + self._trunk_height_error())
             physics.forward()
             physics.step(int(round(SETTLE_TIME / physics.model.opt.timestep)))
         super().initialize_episode(physics)
@@ -226,11 +228,18 @@ class _QuadrupedTaskMixin:
 
     def leg_targets(self, physics) -> np.ndarray:
         t = self.episode_time(physics)
-        height = float(self.height_schedule(t)) + legs.SAG_COMPENSATION[self.episode_legs]
+        height = (float(self.height_schedule(t)) + legs.SAG_COMPENSATION[self.episode_legs]
+                  + self._trunk_height_error())
         if self.episode_legs == "stand":
             return _STANDING.joint_targets(t, height)
         scale = self.stride_scale(physics) if self.steer else None
+        if isinstance(self.randomizer, perturbations.Perturber):  # the gait's clock is off (gait_timing)
+            t = self.randomizer.gait_rate * t + self.randomizer.gait_phase
         return self.gait.joint_targets(t, height, scale)
+
+    def _trunk_height_error(self) -> float:
+        """How much higher the trunk stands than commanded (tasks.perturbations' trunk_height)."""
+        return self.randomizer.trunk_height_offset if isinstance(self.randomizer, perturbations.Perturber) else 0.0
 
     def stride_scale(self, physics) -> np.ndarray:
         """Per-leg scale of the fore-aft foot travel that turns back onto the walking line."""

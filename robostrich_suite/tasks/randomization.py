@@ -94,6 +94,17 @@ class Randomizer:
         model.actuator_biasprm[n["actuators"]] = n["bias"] * scales["tendon_gain"][:, None]
         return scales
 
+    def begin_episode(self, physics, random: np.random.RandomState, continuing: bool) -> None:
+        """Every episode draws new parameters (``continuing``: it starts where the last one ended)."""
+        self.apply(physics, random)
+
+    def delayed(self, action):
+        """The action that reaches the servos (tasks.perturbations delays it; here it is not)."""
+        return action
+
+    def begin_actions(self, held) -> None:
+        """Nothing held back here (tasks.perturbations: the input held until a delayed action arrives)."""
+
     def observe_joint_angles(self, angles: np.ndarray, random: np.random.RandomState
                              ) -> np.ndarray:
         if self.config.joint_angle_noise == 0:

@@ -25,6 +25,7 @@ from dm_env import specs
 
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.tasks import options
+from robostrich_suite.tasks import perturbations as perturbations_lib
 from robostrich_suite.tasks import randomization as randomization_lib
 from robostrich_suite.tasks import rewards
 from robostrich_suite.tasks.actions import check_action
@@ -62,7 +63,9 @@ class ReachConfig:
     and a (deg) of eqs. 9-10; desired_attitude: the head attitude to hold (deg; 90 = level);
     weights: lambda_1..lambda_4 (a ``RewardWeights`` or a dict of its fields); target_axes: the
     world axes the targets are given in; randomization: a ``DomainRandomization`` (or a dict of
-    its fields) drawing new arm parameters every episode, None = off.
+    its fields) drawing new arm parameters every episode, None = off; perturbation: a
+    ``perturbations.Perturbation`` (or a dict of its fields), the robot differing from the model by
+    the families and scales it names (the robustness tool's and ``--randomize``'s), None = off.
     """
     reward: str = "lesson2"
     initial_state: str = "fixed"
@@ -79,6 +82,7 @@ class ReachConfig:
     release_starts: float = 0.0
     release_time: float = RELEASE_TIME
     fixed_stored_starts: float = 0.0
+    perturbation: object = None
 
 
 def default_config() -> ReachConfig:
@@ -112,6 +116,12 @@ class Reach(base.Task):
                                          randomization_lib.DomainRandomization)
         self.randomizer = (randomization_lib.Randomizer(randomization)
                            if randomization is not None else None)
+        perturbation = options.instance("perturbation", config.perturbation, perturbations_lib.Perturbation)
+        if perturbation is not None and perturbation.active():  # all scales 0: the nominal task
+            if self.randomizer is not None:
+                raise ValueError("randomization and perturbation both change the robot; set one of them")
+            self.randomizer = perturbations_lib.Perturber(perturbation)
+        self._robot_ready = False  # see _begin_robot
         self.target_position = self.target_pool[0].copy()
         self._last_reached = None
         self._head_reading = None
@@ -176,13 +186,24 @@ class Reach(base.Task):
         if self._samples_failures():  # before anything moves the physics
             self.sampler.record(self._last_reached)
             self._last_reached = None
-        if self.randomizer is not None:
-            self.randomizer.apply(physics, self.random)
+        if not self._robot_ready:
+            self._begin_robot(physics)
+        self._robot_ready = False
         self.starts.begin(physics, self.random, self._continuing_state(physics)
                           if self.initial_state == "continue" else None)
+        if self.randomizer is not None:
+            self.randomizer.begin_actions(physics.arm_control())
         self.target_position = self.next_target()
         super().initialize_episode(physics)
         self._continues_from_physics = True
+
+    def _begin_robot(self, physics) -> None:
+        """This episode's robot (randomisation, perturbation); a task that must know it before
+        ``initialize_episode`` (the quadruped's trunk height) calls this first, and it is drawn once."""
+        if self.randomizer is not None:
+            continuing = self.initial_state == "continue" and self._continuing_state(physics) is not None
+            self.randomizer.begin_episode(physics, self.random, continuing)
+        self._robot_ready = True
 
     def _continuing_state(self, physics):
         """The state a "continue" episode starts from while ``initialize_episode`` runs: where the
@@ -252,6 +273,8 @@ class Reach(base.Task):
 
     def _set_action(self, action, physics) -> None:
         controls = physics.arm_control_view()
+        if self.randomizer is not None:  # an action may reach the servos late (tasks.perturbations)
+            action = self.randomizer.delayed(check_action(action, physics.arm_control_bounds()))
         if controls is None:
             physics.set_arm_control(check_action(action, physics.arm_control_bounds()))
         else:  # checked and clipped straight into the simulation's controls
