@@ -47,6 +47,7 @@ setup(
             "robostrich-targets = agents.robostrich.commands:targets",
             "robostrich-gait = agents.robostrich.commands:gait",
             "robostrich-sweep = agents.robostrich.commands:sweep",
+            "robostrich-robustness = agents.robostrich.commands:robustness",
         ],
     },
 )

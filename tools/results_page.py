@@ -5,6 +5,7 @@
     python tools/results_page.py add dmc_check runs/dmc/dmc.json --title "The learner on dm_control"
     python tools/results_page.py add layouts out/layouts/layouts.json --title "Tendon routings compared"
     python tools/results_page.py add speed_env runs/speed_env.json --title "Environment speed"
+    python tools/results_page.py add robustness_robostrich out/robustness/robustness.json --title "Robustness"
     python tools/results_page.py            # rewrite docs/results.md and every block
     python tools/results_page.py --check    # exit 1 when any of them differs from the records
 
@@ -17,7 +18,8 @@ a page merely out of date from a damaged record.
 A record (docs/results/NAME.json) keeps what a benchmark wrote, the command that made it, the date
 and the machine. Its kind says which benchmark: "seeds" (one group of robostrich-sweep's
 sweep.json, or an earlier tools/benchmark_seeds.py seeds.json; tools/results_seeds.py renders it),
-"dmc" (tools/benchmark_dmc.py's dmc.json), "layouts" (robostrich-layouts' layouts.json) or
+"dmc" (tools/benchmark_dmc.py's dmc.json), "layouts" (robostrich-layouts' layouts.json),
+"robustness" (robostrich-robustness's robustness.json) or
 "speed" (tools/benchmark_env.py, benchmark_a1.py or benchmark_learner.py with --json). Numbers are
 typed nowhere else: the page and each block "<!-- results: NAME ... -->" in README.md or a page of
 docs/ are rendered from the records, and tests/test_results_page.py fails when the committed text
@@ -34,6 +36,7 @@ import sys
 
 import results_dmc
 import results_layouts
+import results_robustness
 import results_seeds
 import results_speed
 
@@ -52,7 +55,8 @@ BLOCK_BEGIN = "<!-- results: {name} (tools/results_page.py writes this table) --
 BLOCK_END = "<!-- /results -->"
 README_RECORD = "main_job"  # the README's first table, which it must have
 
-KINDS = {"seeds": results_seeds, "dmc": results_dmc, "layouts": results_layouts, "speed": results_speed}
+KINDS = {"seeds": results_seeds, "dmc": results_dmc, "layouts": results_layouts, "speed": results_speed,
+         "robustness": results_robustness}
 STALE, BAD_INPUT = 1, 2  # exit statuses besides 0 (module doc)
 # A record's fields and their types; "note" and "order" may be left out.
 RECORD_FIELDS = {"format": int, "name": str, "title": str, "kind": str, "command": str, "date": str,
