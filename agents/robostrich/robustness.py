@@ -165,7 +165,8 @@ def summary(args, evaluated_list, results, domain) -> dict:
 
 
 def build_parser() -> cli_lib.Parser:
-    parser = cli_lib.Parser(prog="robostrich-robustness", description="Held-out success of a policy (and the lookup baseline) as the robot "
+    parser = cli_lib.Parser(prog="robostrich-robustness",
+                            description="Held-out success of a policy (and the lookup baseline) as the robot "
                                         "differs from its model: one family of differences at a time at "
                                         "increasing scale, then all at once. Writes robustness.json and .png.")
     parser.add_argument("policy", help=f"a shipped policy ({', '.join(policies.SHIPPED)}), a policy file (.npz) "

@@ -1,8 +1,8 @@
 """The robot differs from its model: one definition of each difference and of its scale s.
 
 Used both to measure how far a policy's success falls (``robostrich-robustness``) and to train
-with those differences (``robostrich-train --task-kwargs '{"perturbation": {"mass": 0.2}}'``), so a scale means the same thing in both. A
-task takes ``perturbation=Perturbation(mass=0.2, ...)`` (or a dict of its fields); scale 0 (the
+with those differences (``robostrich-train --task-kwargs '{"perturbation": {"mass": 0.2}}'``), so a
+scale means the same thing in both. A task takes ``perturbation=Perturbation(mass=0.2, ...)`` (or a dict of its fields); scale 0 (the
 default of every family) changes nothing and draws nothing: the task and its random stream are
 the nominal ones.
 
