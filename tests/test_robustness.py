@@ -190,3 +190,10 @@ def test_bad_input_is_one_line_and_exit_status_2(argv, message, tmp_path, capsys
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.startswith("robostrich-robustness: error:") and message in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_robustness_file_without_results_is_refused_naming_it(tmp_path):
+    path = tmp_path / "robustness.json"
+    path.write_text(json.dumps({"benchmark": "robustness", "scales": [0.0]}))
+    with pytest.raises(ValueError, match=str(path)):
+        results_page.make_record("robustness_bad", str(path), "Robustness")
