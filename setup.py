@@ -28,9 +28,11 @@ setup(
     ],
     extras_require={
         # ray: the sweep's tests start a local Ray, and CI installs only this extra
-        "test": ["pytest==9.2.0", "pytest-xdist==3.8.0", "gymnasium==1.4.0", "ray==2.60.0"],
+        # optuna: robostrich-design's tests run a search (tests/test_design.py), and CI installs only this extra
+        "test": ["pytest==9.2.0", "pytest-xdist==3.8.0", "gymnasium==1.4.0", "ray==2.60.0", "optuna==5.1.0"],
         "gym": ["gymnasium==1.4.0"],
         "sweep": ["ray==2.60.0"],  # robostrich-sweep: grids of runs as Ray tasks
+        "design": ["optuna==5.1.0"],  # robostrich-design: the routing search (its study in SQLite via SQLAlchemy)
     },
     entry_points={
         "console_scripts": [
@@ -47,6 +49,7 @@ setup(
             "robostrich-targets = agents.robostrich.commands:targets",
             "robostrich-gait = agents.robostrich.commands:gait",
             "robostrich-sweep = agents.robostrich.commands:sweep",
+            "robostrich-design = agents.robostrich.commands:design",
             "robostrich-robustness = agents.robostrich.commands:robustness",
         ],
     },

@@ -18,6 +18,8 @@ level poses into families, and measures what decides it:
   mount the neck passes the barrier's height.
 
 Writes OUT/gap_kinematics.png (the families, the pivot, the crossings) and OUT/gap_kinematics.json.
+The neck's geometry is robostrich_suite/studies/gap_column.py's, which robostrich-design's gap measure
+(the tallest column of level poses through a slot, for any routing) is built on.
 """
 import argparse
 import json
@@ -27,32 +29,25 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from robostrich_suite.studies.gap_column import SAMPLES_PER_CAPSULE  # noqa: E402  (points per capsule)
 
 LEVEL_TOLERANCE = 5.0  # deg, as the tasks' attitude tolerance
 AGREEMENT = 0.02  # m: poses "agree" up to the last neck point where 95 % of them lie within this of their mean
 BARRIER_BAND = (0.48, 0.51)  # m above ground: just over the curled poses' highest point
-SAMPLES_PER_CAPSULE = 5
 
 
 def capsule_points(physics, geoms) -> np.ndarray:
     """(n, 2) (forward, up) points along every arm geom's axis, base to head, in the trunk frame."""
-    model, data = physics.model, physics.data
-    points = []
-    for g in geoms:
-        centre, axis = data.geom_xpos[g], data.geom_xmat[g].reshape(3, 3)[:, 2]
-        half = model.geom_size[g][1] if model.geom_type[g] == 3 else 0.0  # 3: capsule
-        for s in np.linspace(-1.0, 1.0, SAMPLES_PER_CAPSULE):
-            points.append(physics.to_trunk_frame(centre + s * half * axis)[[0, 2]])
-    return np.array(points)
+    from robostrich_suite.studies import gap_column
+    return gap_column.capsule_points(physics, geoms, lambda point: physics.to_trunk_frame(point)[[0, 2]])
 
 
 def hold_all(env, controls):
     """Head (forward, up), unwrapped attitude and neck points of every input held for 2 s."""
-    from robostrich_suite.physics import arm_ids
+    from robostrich_suite.studies import gap_column
     from robostrich_suite.tasks.starts import STORED_START_SETTLE_TIME, hold_before_episode
     physics = env.physics
-    bodies = set(arm_ids(physics.model, "body").tolist())
-    geoms = [g for g in range(physics.model.ngeom) if int(physics.model.geom_bodyid[g]) in bodies]
+    geoms = gap_column.arm_geoms(physics)
     head, attitude, neck = [], [], []
     for inputs in controls:
         env.reset()
@@ -93,11 +88,10 @@ def swept_heights(neck, mask, forward: float) -> list:
 def crossings(env, controls, start, goal, count, seed=0):
     """Ramp from curled to raised inputs over 1 s; per transition the rearmost x at which any
     neck point lies in BARRIER_BAND, and the rearmost of the goal pose itself."""
+    from robostrich_suite.studies import gap_column
     from robostrich_suite.tasks.starts import STORED_START_SETTLE_TIME, hold_before_episode
-    from robostrich_suite.physics import arm_ids
     physics = env.physics
-    bodies = set(arm_ids(physics.model, "body").tolist())
-    geoms = [g for g in range(physics.model.ngeom) if int(physics.model.geom_bodyid[g]) in bodies]
+    geoms = gap_column.arm_geoms(physics)
     rng = np.random.default_rng(seed)
     steps = int(round(env.control_timestep() / physics.timestep()))
     rows = []

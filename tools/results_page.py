@@ -5,6 +5,7 @@
     python tools/results_page.py add dmc_check runs/dmc/dmc.json --title "The learner on dm_control"
     python tools/results_page.py add layouts out/layouts/layouts.json --title "Tendon routings compared"
     python tools/results_page.py add speed_env runs/speed_env.json --title "Environment speed"
+    python tools/results_page.py add design out/design/design.json --title "Routings searched"
     python tools/results_page.py add robustness_robostrich out/robustness/robustness.json --title "Robustness"
     python tools/results_page.py            # rewrite docs/results.md and every block
     python tools/results_page.py --check    # exit 1 when any of them differs from the records
@@ -19,8 +20,8 @@ A record (docs/results/NAME.json) keeps what a benchmark wrote, the command that
 and the machine. Its kind says which benchmark: "seeds" (one group of robostrich-sweep's
 sweep.json, or an earlier tools/benchmark_seeds.py seeds.json; tools/results_seeds.py renders it),
 "dmc" (tools/benchmark_dmc.py's dmc.json), "layouts" (robostrich-layouts' layouts.json),
-"robustness" (robostrich-robustness's robustness.json) or
-"speed" (tools/benchmark_env.py, benchmark_a1.py or benchmark_learner.py with --json). Numbers are
+"design" (robostrich-design's design.json), "robustness" (robostrich-robustness's robustness.json)
+or "speed" (tools/benchmark_env.py, benchmark_a1.py or benchmark_learner.py with --json). Numbers are
 typed nowhere else: the page and each block "<!-- results: NAME ... -->" in README.md or a page of
 docs/ are rendered from the records, and tests/test_results_page.py fails when the committed text
 differs from what the records give.
@@ -34,6 +35,7 @@ import platform
 import re
 import sys
 
+import results_design
 import results_dmc
 import results_layouts
 import results_robustness
@@ -56,7 +58,7 @@ BLOCK_END = "<!-- /results -->"
 README_RECORD = "main_job"  # the README's first table, which it must have
 
 KINDS = {"seeds": results_seeds, "dmc": results_dmc, "layouts": results_layouts, "speed": results_speed,
-         "robustness": results_robustness}
+         "design": results_design, "robustness": results_robustness}
 STALE, BAD_INPUT = 1, 2  # exit statuses besides 0 (module doc)
 # A record's fields and their types; "note" and "order" may be left out.
 RECORD_FIELDS = {"format": int, "name": str, "title": str, "kind": str, "command": str, "date": str,
@@ -86,7 +88,7 @@ def make_record(name: str, path: str, title: str, command: str = None, date: str
                 group: str = None) -> dict:
     """A record of what a benchmark wrote: one group of a robostrich-sweep sweep.json (or an earlier
     tools/benchmark_seeds.py seeds.json), tools/benchmark_dmc.py's dmc.json, robostrich-layouts'
-    layouts.json or a speed benchmark's --json file; the command it records unless ``command`` says."""
+    layouts.json, robostrich-design's design.json or a speed benchmark's --json file; the command it records unless ``command`` says."""
     written = parsing.read_json(path)
     if not isinstance(written, dict):
         raise ValueError(f"{path}: a JSON {type(written).__name__}, not the object a benchmark writes")
@@ -241,7 +243,8 @@ def build_parser() -> argparse.ArgumentParser:
     add = sub.add_parser("add", allow_abbrev=False, help="store what a benchmark wrote as a record in docs/results/")
     add.add_argument("name", help="the record's name (docs/results/NAME.json; a block names it)")
     add.add_argument("written", help="OUT/sweep.json of robostrich-sweep (or an earlier seeds.json), dmc.json of "
-                     "tools/benchmark_dmc.py, layouts.json of robostrich-layouts, or a speed benchmark's --json file")
+                     "tools/benchmark_dmc.py, layouts.json of robostrich-layouts, design.json of robostrich-design, or a "
+                     "speed benchmark's --json file")
     add.add_argument("--title", required=True)
     add.add_argument("--group", default=None, help="the sweep's group to record (default: its only one)")
     add.add_argument("--command", dest="run_command", default=None,

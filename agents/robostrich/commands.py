@@ -28,6 +28,7 @@ COMMANDS = {
     "robostrich-targets": "robostrich_suite.studies.target_generation:cli",
     "robostrich-gait": "robostrich_suite.studies.gait_generation:cli",
     "robostrich-sweep": "agents.robostrich.sweep:cli",
+    "robostrich-design": "robostrich_suite.studies.design:cli",
     "robostrich-robustness": "agents.robostrich.robustness:cli",
 }
 
@@ -74,4 +75,5 @@ workspace = _entry("robostrich-workspace")
 targets = _entry("robostrich-targets")
 gait = _entry("robostrich-gait")
 sweep = _entry("robostrich-sweep")
+design = _entry("robostrich-design")
 robustness = _entry("robostrich-robustness")

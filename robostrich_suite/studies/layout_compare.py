@@ -102,15 +102,16 @@ def movement_layout(layout: arm_lib.TendonLayout, spec: arm_lib.ArmSpec):
     return arm_lib.TendonLayout(tuple(renamed))
 
 
-def movement_ratio(case: Case) -> dict:
-    """Rolling and lever attitude ranges at equal head travel (the movement tests' defaults)."""
+def movement_ratio(case: Case, iterations: int = 7) -> dict:
+    """Rolling and lever attitude ranges at equal head travel (the movement tests' defaults;
+    ``iterations`` of the lever amplitude's bisection: fewer is a cheaper, coarser match)."""
     layout = movement_layout(case.layout, case.spec)
     if layout is None:
         return {"rolling_range_deg": None, "lever_range_deg": None, "rolling_lever_ratio": None,
                 "head_travel_mm": None}
     rolling = movement.run(_LayoutMovement(tendon_layout=layout), case.spec)
     lever = _LayoutMovement(pattern="lever", tendon_layout=layout)
-    amplitude = movement.match_lever_amplitude(lever, rolling.head_travel(), case.spec)
+    amplitude = movement.match_lever_amplitude(lever, rolling.head_travel(), case.spec, iterations)
     lever = movement.run(dataclasses.replace(lever, lever_amplitude=amplitude), case.spec)
     ratio = rolling.attitude_range() / max(lever.attitude_range(), 1e-9)
     return {"rolling_range_deg": rolling.attitude_range(), "lever_range_deg": lever.attitude_range(),

@@ -1,0 +1,108 @@
+"""robostrich-design: search tendon routings for the paper's tests and the narrow gap.
+
+    robostrich-design --trials 200 --out out/design            # resumable: run it again to go on
+    robostrich-design --trials 0 --confirm 3 --out out/design  # full measures of the front's best 3
+
+The space is :mod:`robostrich_suite.studies.design_space` (Table 1's links, one dorsal and eight
+ventral tendons through run-through holes; origins, insertions and hole offsets searched).
+Each trial is scored cheaply (:mod:`robostrich_suite.studies.design_objectives`, ``--pose-budget``).
+
+**Two objectives and one constraint.**  Maximised: the share of the blue region held level
+(coverage) and the height of the gap column (the narrow gap's measure).  Constrained: the
+rolling/lever attitude ratio at most :data:`RATIO_LIMIT`, the paper's "well below 1" made a
+number (the Fig. 1B candidates measure 0.31-0.42; routings from the base 1.25-2).  The ratio is a
+test the paper's arm passes, not a quantity to trade, so it bounds the search instead of
+spreading the front over a third axis; coverage and the gap column do trade (a neck that rises
+under its head reaches less of the region in front), and the front shows how.
+
+**Multi-objective TPE** (Optuna's ``TPESampler`` with ``constraints_func``; ``constant_liar`` so
+that several machines on one ``--storage`` do not all try the same routing): with a few hundred
+trials of ~10 s it is the more sample-efficient choice; NSGA-II needs generations of a population
+each larger than that budget allows to do better than random draws.
+
+The study lives in Optuna's RDB storage (SQLite in ``OUT/study.db`` unless ``--storage`` names any
+SQLAlchemy URL): each trial is committed when it ends, so Ctrl-C or a killed machine keeps every
+finished trial, and the running one is marked failed (by the command, or by the heartbeat from
+another process); the same command again resumes until ``--trials`` trials are complete.
+
+Writes into ``--out``: ``front.png`` (the Pareto front), ``design.json`` (the front, the trials'
+rate, the gap column the task needs; ``tools/results_page.py add NAME OUT/design.json`` records
+it) and ``layouts/trial_N.json`` (the front's routings as layout files, for ``--layout-file`` and
+``task_kwargs={"tendon_layout": path}``); with ``--confirm K`` the full measures of the front's best
+K (``robostrich-layouts``' coverage, movement tests and targets, the gap measure at
+``design_objectives.FULL``) are kept in the study and go into ``design.json`` too.
+"""
+from __future__ import annotations
+
+import pathlib
+import shlex
+import sys
+import warnings
+
+from robostrich_suite import cli as cli_lib
+
+PROG = "robostrich-design"
+RATIO_LIMIT = 0.6  # rolling / lever attitude ratio a routing must not pass (module doc)
+OBJECTIVES = ("coverage", "gap_column_m")  # both maximised
+MAX_TRIALS = 100_000
+MAX_POSE_BUDGET = 2_000
+MIN_POSE_BUDGET = 6  # two coverage cells, three column targets, one to grow a column
+HEARTBEAT_S, GRACE_S = 30, 120  # a trial silent this long was on a machine that died: failed
+FRONT_LAYOUTS = 10  # the front's routings written as layout files, best gap column first
+
+
+def build_parser() -> cli_lib.Parser:
+    parser = cli_lib.Parser(prog=PROG, description=__doc__.splitlines()[0])
+    parser.add_argument("--trials", type=cli_lib.whole_number(0, MAX_TRIALS), default=100,
+                        help="complete trials the study should hold; a resumed study runs only the rest "
+                             "(0: write the outputs of the study as it is) (default: %(default)s)")
+    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/design"),
+                        help="output directory (default: %(default)s)")
+    parser.add_argument("--storage", default=None,
+                        help="Optuna storage URL, e.g. sqlite:///study.db or postgresql://... for several "
+                             "machines on one study (default: sqlite:///OUT/study.db)")
+    parser.add_argument("--study-name", default="robostrich-design", help="the study's name (default: %(default)s)")
+    parser.add_argument("--seed", type=cli_lib.seed, default=0,
+                        help="the sampler's seed (offset by the trials already in the study) (default: %(default)s)")
+    parser.add_argument("--pose-budget", type=cli_lib.whole_number(MIN_POSE_BUDGET, MAX_POSE_BUDGET), default=36,
+                        help="sought poses per trial, fixed for a study (default: %(default)s)")
+    parser.add_argument("--search-stiffness", action="store_true",
+                        help="search the passive joint stiffness too (0.5-4 N m/rad), fixed for a study")
+    parser.add_argument("--start-from", nargs="+", default=[], metavar="LAYOUT",
+                        help="built-in layouts or layout files tried first, when the study is new "
+                             "(each must be in the space: 1 dorsal + 8 ventral tendons through every link)")
+    parser.add_argument("--confirm", type=cli_lib.whole_number(0, 50), default=0, metavar="K",
+                        help="full measures of the front's best K routings (by gap column, then coverage)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar, only the summary")
+    return parser
+
+
+def main(argv=None) -> dict:
+    args = build_parser().parse_args(argv)
+    from robostrich_suite.studies import design_report, design_study
+    starts = [design_study.start_layout(item) for item in args.start_from]  # bad ones fail before any work
+    args.out.mkdir(parents=True, exist_ok=True)
+    storage_url = args.storage or f"sqlite:///{(args.out / 'study.db').resolve()}"
+    study = design_study.open_study(storage_url, args.study_name, args.pose_budget, args.search_stiffness, args.seed)
+    command = shlex.join([PROG, *(sys.argv[1:] if argv is None else argv)])
+    with cli_lib.deferred_interrupts():
+        design_study.enqueue_once(study, starts, args.search_stiffness)
+        design_study.run_trials(study, args.trials, args.pose_budget, args.search_stiffness,
+                                show_progress=not args.quiet)
+        if cli_lib.interrupted():
+            raise KeyboardInterrupt
+    # Outside the deferral: Ctrl-C stops a confirmation at once; each routing's measures are kept as it ends.
+    confirmed = design_study.confirm(study, args.confirm, args.out, show_progress=not args.quiet)
+    summary = design_report.write(study, args.out, command, storage_url, confirmed)
+    design_report.print_summary(summary, args.out)
+    return summary
+
+
+def cli(argv=None) -> int:
+    """Exit status 0, 2 with one line on bad input, 130 on Ctrl-C, 143 on SIGTERM (robostrich_suite.cli)."""
+    warnings.filterwarnings("ignore", module="optuna")
+    return cli_lib.run(main, PROG, argv)
+
+
+if __name__ == "__main__":
+    sys.exit(cli())

@@ -1,0 +1,177 @@
+"""The Optuna study behind ``robostrich-design``: opening or resuming it, its trials, the front.
+
+A study is fixed to one pose budget and one choice of searching the stiffness (its user
+attributes): trials scored at different budgets do not compare, so resuming with others is refused.
+Each trial stores its measures as the user attribute ``result`` and the constraint
+(rolling/lever ratio minus ``design.RATIO_LIMIT``, feasible at <= 0) as the user attribute
+``constraint`` and as Optuna's own constraint, which the sampler reads.
+"""
+from __future__ import annotations
+
+import math
+import pathlib
+
+from robostrich_suite import cli as cli_lib
+from robostrich_suite.model import layouts as layouts_lib
+from robostrich_suite.studies import design_objectives, design_space
+
+MAX_RATIO = 1e3  # a routing whose lever hardly turns the head: the ratio is "huge", kept finite
+
+
+def _optuna():
+    import optuna
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    return optuna
+
+
+def sampler(seed: int):
+    """Multi-objective TPE; it reads each trial's constraint (``Trial.set_constraint``) itself."""
+    optuna = _optuna()
+    return optuna.samplers.TPESampler(seed=seed, constant_liar=True)
+
+
+def open_study(url: str, name: str, pose_budget: int, stiffness: bool, seed: int):
+    """The study ``name`` in ``url``, made if new; ValueError (one line) for a bad URL or a study
+    of another budget.  The sampler's seed is offset by the trials it holds, so a resumed study
+    does not draw its first routings again."""
+    optuna = _optuna()
+    from robostrich_suite.studies import design
+    try:
+        storage = optuna.storages.RDBStorage(url, heartbeat_interval=design.HEARTBEAT_S,
+                                             grace_period=design.GRACE_S)
+    except Exception as error:  # SQLAlchemy's URL, driver and connection errors have no common base
+        if isinstance(error, (KeyboardInterrupt, SystemExit)):
+            raise
+        raise ValueError(f"--storage {redacted(url)}: {type(error).__name__}: {error}") from None
+    study = optuna.create_study(storage=storage, study_name=name, load_if_exists=True,
+                                directions=["maximize"] * len(design.OBJECTIVES))
+    if list(study.directions) != [optuna.study.StudyDirection.MAXIMIZE] * len(design.OBJECTIVES):
+        raise ValueError(f"study {name!r} in {redacted(url)} is not a robostrich-design study")
+    attrs = study.user_attrs
+    if not attrs:
+        study.set_user_attr("pose_budget", pose_budget)
+        study.set_user_attr("search_stiffness", stiffness)
+    elif (attrs.get("pose_budget"), attrs.get("search_stiffness")) != (pose_budget, stiffness):
+        raise ValueError(f"study {name!r} was started with --pose-budget {attrs.get('pose_budget')}"
+                         f"{' --search-stiffness' if attrs.get('search_stiffness') else ''}: resume it with the "
+                         "same, or give another --study-name")
+    study.sampler = sampler(seed + len(study.trials))
+    return study
+
+
+def redacted(url: str) -> str:
+    """``url`` without its password (it is printed and written into design.json)."""
+    try:
+        from sqlalchemy.engine import make_url
+        return make_url(url).render_as_string(hide_password=True)
+    except Exception:  # not a URL at all: nothing to hide that make_url could find
+        return url
+
+
+def start_layout(item: str):
+    """A built-in layout's name or a layout file, as search parameters (ValueError if outside the space)."""
+    if item.lower().endswith((".json", ".toml")):
+        name, layout = layouts_lib.read_file(item, design_space.SPEC)
+    else:
+        name, layout = item, layouts_lib.build(item)
+    try:
+        return design_space.parameters(layout)
+    except ValueError as error:
+        raise ValueError(f"--start-from {name}: {error}") from None
+
+
+def enqueue_once(study, starts: list, stiffness: bool) -> None:
+    """Queue the ``--start-from`` routings as a new study's first trials."""
+    if not starts or study.user_attrs.get("started_from"):
+        return
+    for params in starts:
+        if stiffness:
+            params = {**params, "stiffness": design_space.SPEC.joint_stiffness}
+        study.enqueue_trial(params)
+    study.set_user_attr("started_from", len(starts))
+
+
+def complete_trials(study) -> list:
+    optuna = _optuna()
+    return study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
+
+
+def objective(pose_budget: int, stiffness: bool):
+    from robostrich_suite.studies import design
+    budget = design_objectives.Budget(poses=pose_budget)
+
+    def score(trial):
+        params = design_space.suggest(trial, stiffness)
+        result = design_objectives.evaluate(design_space.spec(params), design_space.layout(params), budget,
+                                            interrupted=cli_lib.interrupted)
+        ratio = result["rolling_lever_ratio"]
+        ratio = MAX_RATIO if ratio is None or not math.isfinite(ratio) else min(ratio, MAX_RATIO)
+        result["rolling_lever_ratio"] = ratio
+        trial.set_user_attr("result", result)
+        trial.set_user_attr("constraint", ratio - design.RATIO_LIMIT)
+        trial.set_constraint("rolling_lever_ratio", ratio - design.RATIO_LIMIT)
+        return tuple(result[name] for name in design.OBJECTIVES)
+    return score
+
+
+def run_trials(study, trials: int, pose_budget: int, stiffness: bool, show_progress: bool = True) -> None:
+    """Trials until the study holds ``trials`` complete ones; Ctrl-C (polled between poses) fails the
+    running trial and stops (the caller raises it)."""
+    from tqdm import tqdm
+    done = len(complete_trials(study))
+    if done >= trials:
+        return
+    score = objective(pose_budget, stiffness)
+    with tqdm(total=trials, initial=done, desc="routings", unit="trial", disable=not show_progress,
+              mininterval=1.0) as bar:
+        while done < trials and not cli_lib.interrupted():
+            try:
+                study.optimize(score, n_trials=1, catch=())
+            except KeyboardInterrupt:  # Optuna marked the trial failed and committed that
+                return
+            now = len(complete_trials(study))
+            bar.update(now - done)
+            done = now
+            front = pareto_front(study)
+            if front:
+                best = max(front, key=lambda t: (t.values[1], t.values[0]))
+                bar.set_postfix_str(f"front {len(front)}, best column {100 * best.values[1]:.1f} cm")
+
+
+def feasible(trial) -> bool:
+    return trial.user_attrs.get("constraint", MAX_RATIO) <= 0
+
+
+def pareto_front(study) -> list:
+    """The feasible complete trials no other feasible one beats on both objectives, best gap column
+    first (ties: coverage, then the earlier trial)."""
+    trials = [t for t in complete_trials(study) if feasible(t)]
+    front = [t for t in trials
+             if not any(all(o >= s for o, s in zip(other.values, t.values)) and other.values != t.values
+                        for other in trials)]
+    unique = {}
+    for t in front:  # equal scores: the first trial stands for them
+        unique.setdefault(tuple(t.values), t)
+    return sorted(unique.values(), key=lambda t: (-t.values[1], -t.values[0], t.number))
+
+
+CONFIRMED = "confirmed_trial_"  # study user attribute of a confirmed trial's full measures, by its number
+
+
+def confirmed(study) -> list:
+    """The full measures of every confirmed trial, in trial order."""
+    rows = [value for key, value in study.user_attrs.items() if key.startswith(CONFIRMED)]
+    return sorted(rows, key=lambda row: row["trial"])
+
+
+def confirm(study, count: int, out: pathlib.Path, show_progress: bool = True) -> list:
+    """The full measures of the front's best ``count`` routings (module doc of design), each kept in
+    the study once measured (a later run reports it without measuring it again)."""
+    if not count or cli_lib.interrupted():
+        return confirmed(study)
+    from robostrich_suite.studies import design_confirm
+    done = {row["trial"] for row in confirmed(study)}
+    todo = [t for t in pareto_front(study)[:count] if t.number not in done]
+    for row in design_confirm.confirm(todo, out, show_progress):
+        study.set_user_attr(f"{CONFIRMED}{row['trial']}", row)
+    return confirmed(study)

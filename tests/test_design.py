@@ -1,0 +1,221 @@
+"""robostrich-design: the routing search, its gap measure, its study's resumption and its outputs."""
+import json
+import os
+import signal
+import sqlite3
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+import robostrich_suite
+from robostrich_suite import scenes
+from robostrich_suite.model import arm, layouts
+from robostrich_suite.studies import design, design_space, gap_column, layout_compare
+
+import results_page
+from conftest import console_script
+
+NECK_RADIUS, HEAD_RADIUS = 0.008, 0.0128
+TINY = ["--pose-budget", str(design.MIN_POSE_BUDGET), "--quiet"]
+
+
+# --------------------------------------------------------------------------- the gap measure
+
+def _pose(points, head):
+    """A pose of polyline ``points`` (neck, base to head's caudal end) and a level head forward of it."""
+    neck = np.concatenate([np.linspace(a, b, 12, endpoint=False) for a, b in zip(points, points[1:])])
+    start = np.asarray(points[-1], float)
+    head_points = np.linspace(start, start + [0.06, 0.0], 5)
+    assert np.allclose(head_points[2], head)
+    return np.concatenate([neck, head_points]), np.r_[np.full(len(neck), NECK_RADIUS), np.full(5, HEAD_RADIUS)]
+
+
+def _held(poses):
+    points, radii = zip(*poses)
+    n = len(poses)
+    heads = np.array([p[-3] for p in points])
+    return gap_column.HeldPoses(np.zeros((n, 9)), heads, np.full(n, 90.0), np.ones(n, bool), np.array(points),
+                                radii[0])
+
+
+def _rising_necks(heights):
+    """Necks that reach forward low, then rise straight up to a level head at x 0.30."""
+    return _held([_pose([(0.0, 0.0), (0.27, 0.05), (0.27, z)], (0.30, z)) for z in heights])
+
+
+def _lever_necks(heights):
+    """Necks straight from the base to the head, as a lever turning about the base."""
+    return _held([_pose([(0.0, 0.0), (0.27, z)], (0.30, z)) for z in heights])
+
+
+def test_a_column_of_necks_rising_through_the_slot_measures_its_height():
+    held = _rising_necks([0.20, 0.24, 0.28])
+    column = gap_column.tallest_column(held, lambda a, b, scene: True)
+    assert column.height == pytest.approx(0.08)
+    assert column.poses == (0, 1, 2)
+    scene = column.scene
+    assert abs(scene.slot_x - 0.30) <= gap_column.COLUMN_TOLERANCE
+    assert scene.shelf_z + scenes.GAP_SHELF_THICKNESS < 0.20 and not scene.touches(held.points, held.radii).any()
+    # A step the ramp cannot make splits the column: the taller part is what counts.
+    cut = gap_column.tallest_column(held, lambda a, b, scene: (a, b) != (1, 2))
+    assert cut.height == pytest.approx(0.04) and cut.poses == (0, 1)
+    # Heads farther apart than a step are not neighbours.
+    assert gap_column.tallest_column(_rising_necks([0.20, 0.30]), lambda a, b, s: True).height == 0.0
+
+
+def test_necks_swinging_as_a_lever_have_no_column_and_a_shelf_across_a_neck_touches_it():
+    held = _lever_necks([0.20, 0.24, 0.28])
+    assert gap_column.columns(held) == []
+    assert gap_column.tallest_column(held, lambda a, b, scene: True).height == 0.0
+    rising = _rising_necks([0.24])
+    assert not gap_column.Scene(0.29, 0.10).touches(rising.points, rising.radii)[0]  # through the slot
+    assert gap_column.Scene(0.20, 0.10).touches(rising.points, rising.radii)[0]  # the shelf across the neck
+
+
+def test_a_ramp_that_stays_still_is_clear_and_one_through_the_shelf_is_not():
+    spec, layout = design_space.SPEC, layouts.build("ventral_slips")
+    physics = scenes.frame_physics(spec, layout)
+    base = np.array(physics.named.data.xpos["arm/c18"])[[0, 2]]
+
+    def to_plane(point):
+        return np.asarray(point)[[0, 2]] - base
+
+    held = gap_column.hold_poses(physics, [np.zeros(9)], to_plane, 2.0)
+    far = gap_column.Scene(held.points[0, :, 0].max() + 1.0, 0.9)  # far ahead and above: nothing near the arm
+    assert gap_column.ramp_stays_clear(physics, held, 0, 0, far, to_plane, 2.0)
+    x, z = held.points[0, len(held.radii) // 2]
+    across = gap_column.Scene(x + 0.1, z - 0.01)  # the near shelf cuts the neck halfway along it
+    assert across.touches(held.points, held.radii)[0]
+    assert not gap_column.ramp_stays_clear(physics, held, 0, 0, across, to_plane, 2.0)
+
+
+# --------------------------------------------------------------------------- the search
+
+def test_a_tiny_search_keeps_the_papers_routing_and_drops_the_one_from_the_base(tmp_path, capsys):
+    out = tmp_path / "out"
+    summary = design.main(["--trials", "2", "--out", str(out), "--start-from", "ventral_from_base", "ventral_slips",
+                           *TINY])
+    rows = {row["trial"]: row for row in summary["front"]}
+    # ventral_from_base (trial 0) fails the paper's rolling/lever test, ventral_slips (trial 1) passes it.
+    assert summary["trials"]["complete"] == 2 and summary["trials"]["feasible"] == 1
+    assert list(rows) == [1] and rows[1]["rolling_lever_ratio"] < design.RATIO_LIMIT
+    written = json.loads((out / "design.json").read_text())
+    assert written["benchmark"] == "design" and written["command"].startswith("robostrich-design --trials 2")
+    assert (out / "front.png").stat().st_size > 0
+    # The front's routing is a layout file that the layouts command and the tasks accept.
+    path = rows[1]["layout_file"]
+    name, layout = layouts.read_file(path)
+    assert name == "design_trial_1" and layout == design_space.layout(design_space.parameters(layouts.build("ventral_slips")))
+    assert [t.links for t in layout.tendons] == [t.links for t in layouts.build("ventral_slips").tendons]
+    env = robostrich_suite.load("robostrich", "lesson1", task_kwargs={"tendon_layout": path})
+    assert env.action_spec().shape == (9,)
+    assert layout_compare.make_cases([], [path], [])[0].label == "design_trial_1"
+    # design.json is what a results record keeps.
+    record = results_page.make_record("design", str(out / "design.json"), "Routings searched", date="2026-12-04")
+    assert record["kind"] == "design" and "layout_file" not in json.dumps(record)
+    page = results_page.render_record(record)
+    assert f"| 1 | {rows[1]['coverage']:.0%} |" in page and "2 routings (1 with rolling/lever" in page
+    assert "front of 1" in capsys.readouterr().out
+
+
+def test_the_space_round_trips_a_routing_and_refuses_one_outside_it():
+    for name in layouts.fig1b_candidates():
+        layout = layouts.build(name)
+        assert [t.links for t in design_space.layout(design_space.parameters(layout)).tendons] == \
+            [t.links for t in layout.tendons]
+    with pytest.raises(ValueError, match="1 dorsal and 8 ventral"):
+        design_space.parameters(layouts.build("antagonist_pairs"))
+
+
+# --------------------------------------------------------------------------- the command
+
+def _complete(db) -> int:
+    if not db.exists():
+        return 0
+    with sqlite3.connect(db, timeout=30) as connection:
+        try:
+            return connection.execute("SELECT COUNT(*) FROM trials WHERE state = 'COMPLETE'").fetchone()[0]
+        except sqlite3.OperationalError:  # the tables are being made
+            return 0
+
+
+def _trials(db) -> dict:
+    import optuna
+    study = optuna.load_study(study_name="robostrich-design", storage=f"sqlite:///{db}")
+    return {t.number: (t.state.name, t.values, t.params) for t in study.get_trials()}
+
+
+def _start(out, trials):
+    env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+    return subprocess.Popen([console_script("robostrich-design"), "--trials", str(trials), "--out", str(out), *TINY],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+
+
+def _wait_for_a_complete_trial(process, db, timeout=300):
+    start = time.monotonic()
+    while _complete(db) < 1:
+        assert process.poll() is None, process.communicate()
+        assert time.monotonic() - start < timeout, "no trial finished"
+        time.sleep(0.2)
+
+
+def test_a_killed_search_resumes_with_its_finished_trials_intact(tmp_path):
+    out = tmp_path / "out"
+    db = out / "study.db"
+    process = _start(out, 50)
+    _wait_for_a_complete_trial(process, db)
+    process.send_signal(signal.SIGKILL)
+    process.communicate()
+    before = {n: t for n, t in _trials(db).items() if t[0] == "COMPLETE"}
+    assert before
+    done = subprocess.run([console_script("robostrich-design"), "--trials", str(len(before) + 1), "--out", str(out),
+                           *TINY], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    after = _trials(db)
+    assert {n: after[n] for n in before} == before  # every finished trial kept as it was
+    assert sum(state == "COMPLETE" for state, _, _ in after.values()) == len(before) + 1
+    assert json.loads((out / "design.json").read_text())["trials"]["complete"] == len(before) + 1
+
+
+def test_ctrl_c_marks_the_running_trial_failed_and_keeps_the_finished_ones(tmp_path):
+    out = tmp_path / "out"
+    db = out / "study.db"
+    process = _start(out, 50)
+    _wait_for_a_complete_trial(process, db)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130, stderr[-3000:]
+    assert stderr.strip().splitlines()[-1] == "robostrich-design: interrupted"
+    states = [state for state, _, _ in _trials(db).values()]
+    assert "RUNNING" not in states and states.count("COMPLETE") >= 1
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--trials", "-1"], "--trials: must be from 0"),
+    (["--pose-budget", "2"], "--pose-budget: must be from 6"),
+    (["--confirm", "x"], "--confirm: invalid whole number"),
+    (["--storage", "nosuchdialect://x"], "--storage nosuchdialect://x:"),
+    (["--start-from", "antagonist_pairs"], "--start-from antagonist_pairs: the search's routings have 1 dorsal"),
+    (["--start-from", "nosuchlayout"], "unknown layout 'nosuchlayout'"),
+])
+def test_bad_input_is_one_line_and_exit_status_2(argv, message, tmp_path, capsys):
+    assert _status([*argv, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("robostrich-design: error: ") and message in err
+
+
+def _status(argv) -> int:
+    """The command's exit status, in this process (a usage error exits from the parser)."""
+    try:
+        return design.cli(argv)
+    except SystemExit as stop:
+        return stop.code
+
+
+def test_a_study_resumed_with_another_pose_budget_is_refused(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert design.cli(["--trials", "0", "--out", str(out), *TINY]) == 0
+    assert design.cli(["--trials", "0", "--out", str(out), "--pose-budget", "7", "--quiet"]) == 2
+    assert "was started with --pose-budget 6" in capsys.readouterr().err

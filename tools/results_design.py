@@ -1,0 +1,56 @@
+"""Tables of a "design" results record: robostrich-design's search of tendon routings (its
+design.json): the Pareto front of coverage and gap column, with the full measures of those confirmed."""
+import json
+
+ROW_NOISE = ("layout_file", "target_file")  # where one run wrote its files: not a result
+
+
+def read(data: dict, path: str, group: str = None) -> tuple:
+    if "front" not in data or "trials" not in data or "need" not in data:
+        raise ValueError(f"{path} is not robostrich-design's design.json (no 'front'/'trials'/'need')")
+    if group is not None:
+        raise ValueError(f"--group {group}: {path} is not a sweep")
+    data = json.loads(json.dumps(data))
+    for row in data["front"] + data.get("confirmed", []):
+        for key in ROW_NOISE:
+            row.pop(key, None)
+    return data, data.get("command")
+
+
+def caption(data: dict) -> str:
+    trials, need = data["trials"], data["need"]
+    rate = (f", {trials['trials_per_core_hour']:g} trials per hour of one core ({trials['trials_per_hour']:g} "
+            "per hour on the clock, the core shared)" if trials.get("trials_per_core_hour") else "")
+    return (f"{trials['complete']} routings ({trials['feasible']} with rolling/lever <= {data['ratio_limit']:g}) at "
+            f"{data['pose_budget']} sought poses each{rate}; best gap column "
+            f"{100 * data['best_feasible_gap_column_m']:.1f} cm ({100 * data['best_gap_column_m']:.1f} cm of any routing), "
+            f"the narrow gap needs {100 * need['column_height_m']:.0f} cm above its shelf")
+
+
+def _percent(value) -> str:
+    return "n/a" if value is None else f"{value:.0%}"
+
+
+def _column(row: dict) -> str:
+    gap = row.get("gap") or {}
+    where = (f" (slot {100 * gap['slot_x_m']:.1f} cm ahead, shelf {100 * gap['shelf_z_m']:.1f} cm up)"
+             if gap.get("slot_x_m") is not None and row["gap_column_m"] else "")
+    return f"{100 * row['gap_column_m']:.1f} cm{where}"
+
+
+def short(data: dict) -> list:
+    """The front, each routing beside its confirmation where it has one."""
+    confirmed = {row["trial"]: row for row in data.get("confirmed", [])}
+    lines = ["| trial | coverage (sampled cells) | gap column | rolling / lever | confirmed coverage | "
+             "confirmed gap column | confirmed rolling / lever |", "|---|---|---|---|---|---|---|"]
+    for row in data["front"]:
+        check = confirmed.get(row["trial"])
+        later = ([_percent(check["coverage"]), _column(check), f"{check['rolling_lever_ratio']:.2f}"] if check
+                 else ["-", "-", "-"])
+        lines.append(f"| {row['trial']} | {_percent(row['coverage'])} | {_column(row)} | "
+                     f"{row['rolling_lever_ratio']:.2f} | " + " | ".join(later) + " |")
+    return lines
+
+
+def full(data: dict) -> list:
+    return short(data)
