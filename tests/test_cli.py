@@ -156,7 +156,7 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     assert_user_error(results["xml_no_out"], "--out")
     assert_user_error(results["task_kwargs"], "--task-kwargs", "robostrich/lesson1", "unknown target_sampling 'worst'")
     assert not (tmp_path / "tk").exists()
-    assert_user_error(results["lesson_names"], "long_horizon_lessons names ['lesson9']")
+    assert_user_error(results["lesson_names"], "--long-horizon-lessons names ['lesson9']")
     assert not (tmp_path / "ln").exists()
     # The action-change term would be dropped by the default recomputed rewards: refused, named.
     assert_user_error(results["action_change"], "weights.action_change", "--no-relabel-rewards --her-ratio 0")

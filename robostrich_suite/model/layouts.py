@@ -219,56 +219,56 @@ def from_dict(data, spec: arm_lib.ArmSpec | None = None, source: str = "layout"
     entries = data.get("tendons")
     if not isinstance(entries, list) or not entries:
         fail("'tendons' must be a non-empty list of tendons")
-    tendons = []
-    for i, entry in enumerate(entries, 1):
-        label = f"tendon {i}"
-        if not isinstance(entry, dict):
-            fail(f"{label}: expected a table/object, got {type(entry).__name__}")
-        if isinstance(entry.get("name"), str):
-            label = f"tendon {i} ({entry['name']!r})"
-        unknown = sorted(set(entry) - set(TENDON_KEYS))
-        if unknown:
-            fail(f"{label}: unknown key(s) {unknown}; a tendon has {list(TENDON_KEYS)}")
-        for key in ("name", "side"):
-            if not isinstance(entry.get(key), str):
-                fail(f"{label}: '{key}' must be a string, got {entry.get(key)!r}")
-        hole_offset = entry.get("hole_offset")
-        low, high = arm_lib.HOLE_OFFSET_RANGE
-        if "hole_offset" in entry and (isinstance(hole_offset, bool) or not isinstance(hole_offset, (int, float))
-                                       or not math.isfinite(hole_offset) or not low <= hole_offset <= high):
-            fail(f"{label}: 'hole_offset' must be a distance from {low} to {high} m (the holes' distance "
-                 f"from the joint axis), got {hole_offset!r}")
-        hole_offset = None if hole_offset is None else float(hole_offset)
-        has_links, has_span = "links" in entry, ("from" in entry or "to" in entry)
-        if has_links == has_span:
-            fail(f"{label}: give either 'links' (caudal to cranial) or 'from' and 'to'")
-        if has_links:
-            links = entry["links"]
-            if not isinstance(links, list) or not all(isinstance(x, str) for x in links):
-                fail(f"{label}: 'links' must be a list of link names, got {links!r}")
-            on_base = entry.get("on_base", True)
-            if not isinstance(on_base, bool):
-                fail(f"{label}: 'on_base' must be true or false, got {on_base!r}")
-            tendons.append(arm_lib.TendonSpec(entry["name"], entry["side"], tuple(links), on_base, hole_offset))
-        else:
-            if "on_base" in entry:
-                fail(f"{label}: 'on_base' goes with 'links'; with 'from' the base link means "
-                     "anchored on the base")
-            for key in ("from", "to"):
-                if not isinstance(entry.get(key), str):
-                    fail(f"{label}: '{key}' must be a link name, got {entry.get(key)!r}")
-            try:
-                tendons.append(dataclasses.replace(
-                    arm_lib.TendonSpec.spanning(entry["name"], entry["side"], entry["to"], spec, origin=entry["from"]),
-                    hole_offset=hole_offset))
-            except ValueError as error:
-                fail(str(error))
-    layout = arm_lib.TendonLayout(tuple(tendons))
+    tendons = tuple(_tendon_from_dict(entry, i, spec, fail) for i, entry in enumerate(entries, 1))
+    layout = arm_lib.TendonLayout(tendons)
     try:
         layout.validate(spec)
     except ValueError as error:
         fail(str(error))
     return layout
+
+
+def _tendon_from_dict(entry, i: int, spec: arm_lib.ArmSpec, fail) -> arm_lib.TendonSpec:
+    """Tendon ``i`` (from 1) of a layout's declarative form; ``fail(message)`` raises."""
+    label = f"tendon {i}"
+    if not isinstance(entry, dict):
+        fail(f"{label}: expected a table/object, got {type(entry).__name__}")
+    if isinstance(entry.get("name"), str):
+        label = f"tendon {i} ({entry['name']!r})"
+    unknown = sorted(set(entry) - set(TENDON_KEYS))
+    if unknown:
+        fail(f"{label}: unknown key(s) {unknown}; a tendon has {list(TENDON_KEYS)}")
+    for key in ("name", "side"):
+        if not isinstance(entry.get(key), str):
+            fail(f"{label}: '{key}' must be a string, got {entry.get(key)!r}")
+    hole_offset = entry.get("hole_offset")
+    low, high = arm_lib.HOLE_OFFSET_RANGE
+    if "hole_offset" in entry and (isinstance(hole_offset, bool) or not isinstance(hole_offset, (int, float))
+                                   or not math.isfinite(hole_offset) or not low <= hole_offset <= high):
+        fail(f"{label}: 'hole_offset' must be a distance from {low} to {high} m (the holes' distance "
+             f"from the joint axis), got {hole_offset!r}")
+    hole_offset = None if hole_offset is None else float(hole_offset)
+    has_links, has_span = "links" in entry, ("from" in entry or "to" in entry)
+    if has_links == has_span:
+        fail(f"{label}: give either 'links' (caudal to cranial) or 'from' and 'to'")
+    if has_links:
+        links = entry["links"]
+        if not isinstance(links, list) or not all(isinstance(x, str) for x in links):
+            fail(f"{label}: 'links' must be a list of link names, got {links!r}")
+        on_base = entry.get("on_base", True)
+        if not isinstance(on_base, bool):
+            fail(f"{label}: 'on_base' must be true or false, got {on_base!r}")
+        return arm_lib.TendonSpec(entry["name"], entry["side"], tuple(links), on_base, hole_offset)
+    if "on_base" in entry:
+        fail(f"{label}: 'on_base' goes with 'links'; with 'from' the base link means anchored on the base")
+    for key in ("from", "to"):
+        if not isinstance(entry.get(key), str):
+            fail(f"{label}: '{key}' must be a link name, got {entry.get(key)!r}")
+    try:
+        spanning = arm_lib.TendonSpec.spanning(entry["name"], entry["side"], entry["to"], spec, origin=entry["from"])
+    except ValueError as error:
+        fail(str(error))
+    return dataclasses.replace(spanning, hole_offset=hole_offset)
 
 
 def read_file(path, spec: arm_lib.ArmSpec | None = None) -> tuple[str, arm_lib.TendonLayout]:
