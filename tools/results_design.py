@@ -33,13 +33,14 @@ def _percent(value) -> str:
 
 def _column(row: dict) -> str:
     gap = row.get("gap") or {}
-    where = (f" (slot {100 * gap['slot_x_m']:.1f} cm ahead, shelf {100 * gap['shelf_z_m']:.1f} cm up)"
+    where = (f" (slot at x {100 * gap['slot_x_m']:.1f} cm, shelf {100 * gap['shelf_z_m']:.1f} cm up)"
              if gap.get("slot_x_m") is not None and row["gap_column_m"] else "")
     return f"{100 * row['gap_column_m']:.1f} cm{where}"
 
 
 def short(data: dict) -> list:
-    """The front, each routing beside its confirmation where it has one."""
+    """The front (cheap scores, with the full measures where a routing has them), then every routing
+    confirmed, on the front now or not."""
     confirmed = {row["trial"]: row for row in data.get("confirmed", [])}
     lines = ["| trial | coverage (sampled cells) | gap column | rolling / lever | confirmed coverage | "
              "confirmed gap column | confirmed rolling / lever |", "|---|---|---|---|---|---|---|"]
@@ -49,6 +50,12 @@ def short(data: dict) -> list:
                  else ["-", "-", "-"])
         lines.append(f"| {row['trial']} | {_percent(row['coverage'])} | {_column(row)} | "
                      f"{row['rolling_lever_ratio']:.2f} | " + " | ".join(later) + " |")
+    if confirmed:
+        lines += ["", "Confirmed (robostrich-layouts' measures, every blue cell; the gap column at the full budget):", "",
+                  "| trial | coverage | distinct level targets | gap column | rolling / lever |", "|---|---|---|---|---|"]
+        lines += [f"| {row['trial']} | {_percent(row['coverage'])} ({row['covered_cells']} of {row['blue_cells']} cells) | "
+                  f"{row['distinct_targets']} | {_column(row)} | {row['rolling_lever_ratio']:.2f} |"
+                  for row in confirmed.values()]
     return lines
 
 
