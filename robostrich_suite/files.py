@@ -3,19 +3,26 @@ half-written target file, figure, table or recording behind, only the old file o
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
 import pathlib
 import tempfile
+
+NAME_MAX = 255  # bytes of one file name (Linux, macOS)
+_SUFFIX = ".partial"
+_RANDOM = 8  # characters tempfile puts between a temporary name's prefix and suffix
 
 
 @contextlib.contextmanager
 def replaced_atomically(path, mode: str = "wb"):
     """Open a temporary file beside ``path`` for writing; when the block ends without an error it
-    is renamed over ``path``, otherwise removed (``path`` keeps what it held)."""
+    is renamed over ``path``, otherwise removed (``path`` keeps what it held). A write that fails
+    (a full disk, a file size limit) names ``path``."""
     fd, tmp = temporary_beside(path)
     try:
-        with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8", "newline": ""})) as handle:
-            yield handle
+        with naming(path, only_unnamed=True):
+            with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8", "newline": ""})) as handle:
+                yield handle
         land(tmp, path)
     finally:
         if os.path.exists(tmp):
@@ -27,24 +34,37 @@ def temporary_beside(path) -> tuple:
     ``path``'s name once whole (``land``); for writers that want a file name, not a handle."""
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    with _naming(path):
-        return tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
+    with naming(path):
+        return tempfile.mkstemp(prefix=temporary_prefix(path.name), suffix=_SUFFIX, dir=path.parent)
+
+
+def temporary_prefix(name: str) -> str:
+    """``.NAME.``, or where the temporary name would pass NAME_MAX (a legal name of 240 bytes or
+    more) NAME's start and a hash of all of it: any name that may be written gets a temporary one."""
+    prefix = f".{name}."
+    room = NAME_MAX - _RANDOM - len(_SUFFIX)
+    if len(os.fsencode(prefix)) <= room:
+        return prefix
+    digest = hashlib.sha256(os.fsencode(name)).hexdigest()[:12]
+    start = os.fsencode(name)[:room - len(digest) - 3].decode("utf-8", "ignore")  # no half character
+    return f".{start}~{digest}."
 
 
 def land(tmp: str, path) -> None:
     """Rename the whole temporary file ``tmp`` (``temporary_beside``) over ``path``."""
-    os.chmod(tmp, 0o644)  # mkstemp makes it private; this is an ordinary output file
-    with _naming(pathlib.Path(path)):
+    with naming(pathlib.Path(path)):
+        os.chmod(tmp, 0o644)  # mkstemp makes it private; this is an ordinary output file
         os.replace(tmp, path)
 
 
 @contextlib.contextmanager
-def _naming(path: pathlib.Path):
-    """An OSError in the block names ``path``, the file the user asked for, not the temporary one."""
+def naming(path, only_unnamed: bool = False):
+    """An OSError in the block names ``path``, the file the user asked for, not the temporary one
+    (or, ``only_unnamed``, no file: a failed write says only "No space left on device")."""
     try:
         yield
     except OSError as error:
-        if error.errno is None:
+        if error.errno is None or (only_unnamed and error.filename is not None):
             raise
         raise type(error)(error.errno, error.strerror, str(path)) from None
 

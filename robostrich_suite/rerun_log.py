@@ -11,8 +11,9 @@ piece of code serves the arm on its frame and the arm on the quadruped.
             rerun_log.set_sim_time(rec, physics.data.time)
             rerun_log.log_body_poses(rec, physics)
 
-A recording streams into a temporary file beside its path and takes the path's name only once
-it is whole (``RecordingFile``): an error or Ctrl-C mid-rollout leaves no half-written ``.rrd``.
+A recording is kept in memory and written through the atomic writer once it is whole
+(``RecordingFile``): an error or Ctrl-C mid-rollout leaves no half-written ``.rrd``, and a write
+that fails (a full disk) is one OSError naming the file, not Rerun's log lines from its writer thread.
 
 Time is on the ``sim_time`` timeline (seconds).  Rerun quaternions are xyzw;
 MuJoCo's are wxyz.
@@ -20,7 +21,6 @@ MuJoCo's are wxyz.
 from __future__ import annotations
 
 import contextlib
-import os
 import pathlib
 import re
 
@@ -34,26 +34,28 @@ SIM_TIME = "sim_time"
 
 
 class RecordingFile:
-    """A recording stream saved to a temporary file beside ``path``: ``close()`` renames it over
-    ``path`` once whole, ``discard()`` removes it (``path`` keeps what it held)."""
+    """A recording stream encoded in memory: ``close()`` writes it to ``path`` whole (through
+    files.replaced_atomically, so a failed write names ``path`` and leaves no partial file),
+    ``discard()`` drops it (``path`` keeps what it held). Rerun's own file sink writes from a
+    thread of its own and only logs a failed write; its stream read once, at the end, is the whole
+    .rrd (one read per chunk would make a file of many streams, which Rerun calls corrupt). Memory:
+    the recording's size, a few MB for a minute of the arm."""
 
     def __init__(self, app_id: str, path: str | pathlib.Path, recording_id: str | None = None):
         self.path = pathlib.Path(path)
-        fd, self.partial = files.temporary_beside(self.path)
-        os.close(fd)
         self.stream = rr.RecordingStream(app_id, recording_id=recording_id)
-        self.stream.save(self.partial)
+        self.encoded = self.stream.binary_stream()
 
     def close(self) -> pathlib.Path:
-        self.stream.flush()
+        data = self.encoded.read(flush=True) or b""
         self.stream.disconnect()
-        files.land(self.partial, self.path)
+        with files.replaced_atomically(self.path) as handle:
+            handle.write(data)
         return self.path
 
     def discard(self) -> None:
         self.stream.disconnect()
-        if os.path.exists(self.partial):
-            os.unlink(self.partial)
+        self.encoded.read(flush=False)  # taken, so that Rerun does not warn of dropped data
 
 
 @contextlib.contextmanager

@@ -1,5 +1,6 @@
-"""Outputs are written whole or not at all: an error while writing leaves the old file as it was
-and no partial file beside it."""
+"""Outputs are written whole or not at all: an error while writing (a full disk included) leaves
+the old file as it was and no partial file beside it, and names the file; any name the system
+allows can be written."""
 import matplotlib
 
 matplotlib.use("Agg")
@@ -54,3 +55,40 @@ def test_a_recording_is_written_whole_or_not_at_all(tmp_path):
     with rerun_log.recording("test", path) as rec:
         rerun_log.log_scalars(rec, "plots", {"x": 1.0})
     assert [p.name for p in tmp_path.iterdir()] == ["rollout.rrd"] and path.stat().st_size > 0
+
+
+@pytest.mark.parametrize("name", ["a" * 246 + ".csv", "\u00e9" * 123 + ".csv", "b" * 255])
+def test_a_name_of_up_to_255_bytes_is_written_under_a_temporary_name_that_fits(tmp_path, name):
+    """The temporary name (``.NAME.XXXXXXXX.partial``) of a long name is shortened, on a character's
+    boundary, instead of failing with "File name too long"."""
+    path = tmp_path / name
+    files.write_text(path, "x\n")
+    assert path.read_text() == "x\n" and [p.name for p in tmp_path.iterdir()] == [name]
+    prefix = files.temporary_prefix(name)
+    assert len(prefix.encode()) + 8 + len(".partial") <= 255 and prefix.startswith("." + name[:10])
+    assert files.temporary_prefix("walk.rrd") == ".walk.rrd."  # short names keep the readable form
+
+
+def test_a_write_that_fails_names_the_file_and_leaves_nothing(tmp_path):
+    """A full disk (here a file size limit, which Python turns into "File too large") mid-write
+    names the path asked for, not the temporary file nor no file at all."""
+    import resource
+    soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+    path = tmp_path / "big.bin"
+    resource.setrlimit(resource.RLIMIT_FSIZE, (4096, hard))
+    try:
+        with pytest.raises(OSError) as caught:
+            with files.replaced_atomically(path) as handle:
+                handle.write(b"x" * 100_000)
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
+    assert caught.value.filename == str(path) and caught.value.strerror == "File too large"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_error_about_another_file_inside_the_block_keeps_its_own_name(tmp_path):
+    with pytest.raises(FileNotFoundError) as caught:
+        with files.replaced_atomically(tmp_path / "out.txt", "w") as handle:
+            handle.write(open(tmp_path / "missing.txt").read())
+    assert caught.value.filename == str(tmp_path / "missing.txt") and list(tmp_path.iterdir()) == []
+

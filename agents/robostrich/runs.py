@@ -105,6 +105,13 @@ class DomainRun(curriculum.CurriculumRun):
                          lessons=lessons, residual=self._residual(plan), episode_probe=probes.episode_metrics,
                          keep_lesson_checkpoints=keep_lesson_checkpoints, episode_state=environment_state)
 
+    def save_checkpoint(self, path: Optional[str] = None):
+        """CurriculumRun's, with a failed write (a full disk) naming the checkpoint."""
+        from robostrich_suite import files
+        path = path or self.checkpoint_path
+        with files.naming(path, only_unnamed=True):
+            super().save_checkpoint(path)
+
     def extra_identity(self) -> dict:
         """The task options, the layout and ``init_from`` (which transfer.initialize may set after building)."""
         return identity_extra(self.plan, self.task_kwargs, self.layout, self.init_from, self.residual_scale)

@@ -523,7 +523,10 @@ def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
                 f.write(json.dumps(record) + "\n")
 
         start, start_steps = time.time(), run.loop.env_steps
-        with cli_lib.deferred_interrupts():  # Ctrl-C: a checkpoint between chunks, then KeyboardInterrupt
+        from robostrich_suite import files
+        with files.naming(run.run_dir, only_unnamed=True), cli_lib.deferred_interrupts():
+            # Ctrl-C: a checkpoint between chunks, then KeyboardInterrupt; a failed write of the
+            # run's records (a full disk) names where the run writes
             run.run(progress=progress, on_eval=on_eval, eval_at=job.eval_at, stop_at_step=job.stop_at_step,
                     stop_requested=cli_lib.interrupted)
         timing = {"seconds": time.time() - start, "env_steps": run.loop.env_steps - start_steps,
@@ -572,9 +575,11 @@ def _worker(spec: RunSpec, job, queue):
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent asks again until it hears this
         queue.put(("interrupted", label, str(error)))
     except (ValueError, OSError) as error:  # a user error: the parent's one line says it all
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # nor a traceback of the parent's later asks
         from robostrich_suite import cli as cli_lib
         queue.put(("user_error", label, cli_lib.error_message(error)))
     except BaseException as error:  # a bug: its traceback follows, the parent names the run
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
         queue.put(("error", label, f"{type(error).__name__}: {error}"))
         raise
 
