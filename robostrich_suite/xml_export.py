@@ -11,6 +11,7 @@ import pathlib
 
 from robostrich_suite import files
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import outputs
 
 
 def _robostrich():
@@ -45,6 +46,7 @@ def main(argv=None) -> None:
     parser.add_argument("--out", type=pathlib.Path, required=True,
                         help="directory to write into (the checked-in copies: the repository's xml/)")
     args = parser.parse_args(argv)
+    outputs.check_directory(args.out)
     for path in export(args.out):
         print(f"wrote {path}")
 

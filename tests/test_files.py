@@ -1,6 +1,9 @@
 """Outputs are written whole or not at all: an error while writing (a full disk included) leaves
 the old file as it was and no partial file beside it, and names the file; any name the system
-allows can be written."""
+allows can be written; a location that cannot be written is refused before anything is made."""
+import os
+import pathlib
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -92,3 +95,35 @@ def test_an_error_about_another_file_inside_the_block_keeps_its_own_name(tmp_pat
             handle.write(open(tmp_path / "missing.txt").read())
     assert caught.value.filename == str(tmp_path / "missing.txt") and list(tmp_path.iterdir()) == []
 
+
+def test_output_locations_are_checked_without_making_anything(tmp_path):
+    from robostrich_suite import outputs
+    regular = tmp_path / "somefile.txt"
+    regular.write_text("")
+    deep = pathlib.Path(*["d"] * 2100)  # 4199 bytes: over PATH_MAX
+    cases = [(outputs.check_directory, tmp_path / deep, "bytes long"),
+             (outputs.check_file, tmp_path / ("n" * 256) / "t.npz", "over the 255"),
+             (outputs.check_directory, regular / "sub", "somefile.txt is a file"),
+             (outputs.check_file, regular / "sub" / "t.npz", "somefile.txt is a file"),
+             (outputs.check_directory, regular, "is a file, not a directory"),
+             (outputs.check_file, tmp_path, "is a directory, not a file")]
+    for check, path, fragment in cases:
+        with pytest.raises(OSError, match=fragment) as caught:
+            check(path)
+        assert "--out" in str(caught.value) and len(str(caught.value)) < 400  # one readable line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["somefile.txt"]
+    assert outputs.check_directory(tmp_path / "new" / "dir") == tmp_path / "new" / "dir"
+    assert outputs.check_file(tmp_path / "new" / ("f" * 255)).name == "f" * 255
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["somefile.txt"]
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes in a read-only directory: nothing to refuse")
+def test_a_directory_without_write_permission_is_refused_before_anything_is_made(tmp_path):
+    from robostrich_suite import outputs
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o555)
+    with pytest.raises(PermissionError, match="cannot write in"):
+        outputs.check_directory(locked / "sub")
+    with pytest.raises(PermissionError, match="cannot write in"):
+        outputs.check_file(locked / "t.npz")
+    assert list(locked.iterdir()) == []

@@ -1,5 +1,8 @@
-"""Where the commands write, as a hostile user or a full disk tests it: any legal file name can be
-written; a disk that fills up is one line naming the file, exit 2, with no partial file left.
+"""Where the commands write, as a hostile user or a full disk tests it: a label is a name and never
+a way out of --out; a location that cannot be written (over PATH_MAX, a name over 255 bytes, under
+a regular file) is one line before any work, with nothing made; any legal file name can be
+written; a disk that fills up is one line naming the file, exit 2, with no partial file left;
+a draw that keeps no pose writes no target file.
 
 Commands run as installed scripts, side by side where they are independent.
 """
@@ -15,6 +18,23 @@ from conftest import finish, start
 
 pytestmark = pytest.mark.usefixtures("shared_jax_cache")
 
+# Every command that takes --out, with what else it needs to get as far as writing; for targets and
+# train enough work that a check made after it would time the test out.
+OUT_COMMANDS = {
+    "robostrich-train": (["--quiet", "--plan", "lesson1:100000000"], ""),
+    "robostrich-evaluate": (["missing.ckpt"], ""),
+    "robostrich-play": ([], ""),
+    "robostrich-movement": ([], ""),
+    "robostrich-workspace": ([], ""),
+    "robostrich-layouts": ([], ""),
+    "robostrich-targets": (["--samples", "1000000"], "t.npz"),
+    "robostrich-walk": ([], ""),
+    "robostrich-gait": ([], "g.csv"),
+    "robostrich-stabilize": ([], ""),
+    "robostrich-gap": ([], ""),
+    "robostrich-export-xml": ([], ""),
+}
+
 
 def one_line_error(result, *fragments):
     """Exit 2 and exactly one stderr line, `NAME: error: ...` holding every fragment."""
@@ -27,8 +47,73 @@ def one_line_error(result, *fragments):
     return lines[0]
 
 
+def shown_lines(stderr: str) -> list:
+    """stderr as a terminal shows it: each line's text after its last carriage return (where a
+    progress bar redraws itself), blank ones left out."""
+    return [shown for shown in (line.rsplit("\r", 1)[-1].rstrip() for line in stderr.split("\n")) if shown]
+
+
 def every_file(directory: pathlib.Path) -> list:
     return sorted(str(p.relative_to(directory)) for p in directory.rglob("*"))
+
+
+def test_an_evaluation_label_is_a_name_not_a_path(tmp_path):
+    """A label starts the report files' names: '../../escaped' would write them outside --out."""
+    out = tmp_path / "a" / "b" / "D"
+    cases = {"../../escaped": "no '/'", "sub/name": "no '/'", "..": "not '..'", "": "no '/'",
+             "x" * 101: "at most 100 bytes", "lookup": "lookup baseline"}
+    processes = {label: start("robostrich-evaluate", "CK.ckpt", "--out", out, f"--label={label}", cwd=tmp_path)
+                 for label in cases}
+    for label, process in processes.items():
+        one_line_error(finish(process), "--label", cases[label])
+    assert every_file(tmp_path) == []
+
+
+def test_a_draw_that_keeps_no_pose_writes_no_target_file(tmp_path):
+    """One draw without tuning towards level keeps no pose: a target file of none would be written
+    and exit 0 (every task that loads it would fail later); refused, one line after the bar."""
+    result = finish(start("robostrich-targets", "--samples", "1", "--seek-level-time", "0", "--workers", "1",
+                          "--out", tmp_path / "zero.npz"))
+    lines = shown_lines(result.stderr)
+    assert result.returncode == 2 and lines[-1].startswith("robostrich-targets: error: none of the 1 poses"), \
+        result.stderr[-3000:]
+    assert all(line.startswith("actuated workspace") for line in lines[:-1]), lines  # the finished draw's bar
+    assert "zero.npz" in lines[-1] and every_file(tmp_path) == []
+
+
+def test_outputs_that_cannot_be_written_are_refused_before_any_work_and_nothing_is_made(tmp_path):
+    """Every command that takes --out checks it first (robostrich_suite/outputs.py): under a regular
+    file, over PATH_MAX (which once made 20 nested directories before failing), a name over 255
+    bytes. Each refusal names --out; targets and train would otherwise draw or train for hours."""
+    regular = tmp_path / "somefile.txt"
+    regular.write_text("")
+    deep = "/".join(["d"] * 2100)  # 4199 bytes
+    processes = {}
+    for name, (args, file_name) in OUT_COMMANDS.items():
+        under_file = regular / "sub" / file_name if file_name else regular / "sub"
+        processes[name, "under_file"] = (start(name, *args, "--out", under_file, cwd=tmp_path),
+                                         ["--out", "somefile.txt is a file"])
+    for name in ("robostrich-train", "robostrich-targets", "robostrich-walk", "robostrich-gait"):
+        args, file_name = OUT_COMMANDS[name]
+        processes[name, "path_max"] = (start(name, *args, "--out", f"{deep}/{file_name or 'o'}", cwd=tmp_path),
+                                       ["--out", "bytes long"])
+        processes[name, "name_max"] = (start(name, *args, "--out", "n" * 256 + "/" + (file_name or "o"), cwd=tmp_path),
+                                       ["--out", "over the 255"])
+    for (name, case), (process, fragments) in processes.items():
+        line = one_line_error(finish(process, timeout=300), *fragments)
+        assert len(line) < 400, (name, case, line)  # the long path is shortened in the line
+    assert every_file(tmp_path) == ["somefile.txt"]
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes in a read-only directory: nothing to refuse")
+def test_a_read_only_output_directory_is_refused_before_the_draw(tmp_path):
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o555)
+    processes = [start("robostrich-targets", "--samples", "1000000", "--out", locked / "t.npz"),
+                 start("robostrich-walk", "--out", locked / "walk")]
+    for process in processes:
+        one_line_error(finish(process, timeout=300), "--out", "cannot write in")
+    assert every_file(locked) == []
 
 
 def test_a_file_name_of_250_bytes_is_written(tmp_path):

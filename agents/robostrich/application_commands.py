@@ -40,6 +40,8 @@ def _parser(description: str, out: str) -> argparse.ArgumentParser:
 
 def _setup(args):
     """Gait, policies and output directory, every input checked before any rollout."""
+    from robostrich_suite import outputs
+    outputs.check_directory(args.out)
     gait = applications.load_gait(args.gait)
     policies = applications.policies(args.checkpoint, args.reference, args.layout)
     os.makedirs(args.out, exist_ok=True)

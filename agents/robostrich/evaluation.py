@@ -17,7 +17,7 @@ from typing import Optional
 
 import numpy as np
 
-from robostrich_suite import files
+from robostrich_suite import files, outputs
 from agents.robostrich import probes
 from agents.robostrich.runs import make_environment
 from agents.robostrich.domains import MOVING_START_TASK, TRACK_TASK, as_domain
@@ -26,6 +26,20 @@ from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, P
 
 MAX_TARGETS = 10_000  # held-out targets (or seeded episodes off the arm) of one evaluation
 target_count = cli_lib.whole_number(1, MAX_TARGETS)  # argparse type of the target counts
+MAX_LABEL_BYTES = 100  # a label starts file names (LABEL_heldout_moving.json): well under a name's 255
+
+
+def evaluation_label(text: str) -> str:
+    """argparse type of --label: a name that starts the report files' names, not a path (a label
+    with a separator or '..' would write outside --out), nor the lookup baseline's own."""
+    from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
+    if not text or text in (".", "..") or any(c in text for c in ("/", "\\", "\0")):
+        raise argparse.ArgumentTypeError(f"must be a name for the report files (no '/', not '..'), got {text!r}")
+    if len(os.fsencode(text)) > MAX_LABEL_BYTES:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_LABEL_BYTES} bytes, got {len(os.fsencode(text))}")
+    if text == LOOKUP_LABEL:
+        raise argparse.ArgumentTypeError(f"{LOOKUP_LABEL!r} names the lookup baseline's reports; choose another")
+    return text
 
 
 def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dict:
@@ -330,8 +344,8 @@ def main(argv=None):
                                                  "held-out targets and the track task.")
     parser.add_argument("checkpoint", help="checkpoint.ckpt written by robostrich-train")
     parser.add_argument("--out", default=None, help="report directory (default: next to the checkpoint)")
-    parser.add_argument("--label", default="eval",
-                        help="name of this evaluation in the report files (default: %(default)s)")
+    parser.add_argument("--label", type=evaluation_label, default="eval",
+                        help="name of this evaluation, the start of its report files' names (default: %(default)s)")
     parser.add_argument("--heldout-task", default=None,
                         help="task for held-out targets (default: lesson2 on robostrich, else the last lesson)")
     parser.add_argument("--track-task", default="track",
@@ -341,6 +355,8 @@ def main(argv=None):
     parser.add_argument("--no-rerun", action="store_true", help="no .rrd recordings")
     parser.add_argument("--no-figures", action="store_true", help="no PNG figures")
     args = parser.parse_args(argv)
+    out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.checkpoint)), "evaluation")
+    outputs.check_directory(out)
     fingerprint = checked_fingerprint(args.checkpoint)  # every input checked before the run is rebuilt
     domain = checkpoint_domain(fingerprint)
     track_task = check_track_task(domain, args.track_task)
@@ -348,7 +364,6 @@ def main(argv=None):
     heldout_task = check_heldout_task(domain, args.heldout_task
                                       or default_heldout_task(domain, parse_plan(fingerprint["plan"])[-1].task))
     run = load_run_from_checkpoint(args.checkpoint)
-    out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.checkpoint)), "evaluation")
     from agents.sac.builder import SACBuilder
     actor = SACBuilder.make_eval_actor(run.loop)
     reports = {args.label: evaluate_agent(actor, run.loop.flattener, out, args.label, domain, heldout_task,

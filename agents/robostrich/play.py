@@ -11,7 +11,7 @@ from agents.robostrich import evaluation, figures
 from agents.robostrich.domains import TRACK_TASK, as_domain
 from agents.robostrich.recording import open_recorder
 from robostrich_suite import cli as cli_lib
-from robostrich_suite import policies
+from robostrich_suite import outputs, policies
 
 LABEL = "policy"
 
@@ -64,6 +64,7 @@ def main(argv=None) -> dict:
                         help="held-out targets to try (default: all)")
     parser.add_argument("--no-rerun", action="store_true", help="write no .rrd recording")
     args = parser.parse_args(argv)
+    outputs.check_directory(args.out)
     policy = policies.load_policy(args.policy)
     domain = as_domain(policy.info.get("domain", "robostrich"), policy.info.get("layout"))
     heldout_task = evaluation.default_heldout_task(domain, TRACK_TASK)

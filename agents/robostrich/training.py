@@ -663,6 +663,8 @@ def _supervise(context, specs, job, progress, workers, queue, active, ends):
 def main(argv=None):
     """The main job: parse and check everything, train every run, evaluate, report; returns the summary."""
     args = build_parser().parse_args(argv)
+    from robostrich_suite import outputs
+    outputs.check_directory(args.out)  # before a minute of building, not after an hour of training
     setup = prepare(args, argv)
     init = check_run_directory(args, setup)
     lock = lock_run_directory(args.out)  # noqa: F841  (held until this process ends)

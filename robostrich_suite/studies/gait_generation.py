@@ -13,6 +13,7 @@ import pathlib
 import numpy as np
 
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import outputs
 from robostrich_suite.model import legs
 from robostrich_suite.tasks import gait as gait_lib
 
@@ -42,6 +43,7 @@ def main(argv=None) -> None:
     parser.add_argument("--rate", type=cli_lib.number(1, 10_000, " samples/s"), default=100.0,
                         help="samples per second, 1-10000 (default: %(default)s)")
     args = parser.parse_args(argv)
+    outputs.check_file(args.out)
     gait = gait_lib.TrotGait(args.frequency, args.stride, args.lift, args.trunk_height)
     times, targets = sample_trot(gait, rate=args.rate)
     gait_lib.write_gait_file(args.out, times, targets, comment=(

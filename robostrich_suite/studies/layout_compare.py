@@ -37,6 +37,7 @@ import time
 
 from robostrich_suite import files
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import outputs
 from robostrich_suite import targets
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite import fingerprint as fingerprint_lib
@@ -324,6 +325,7 @@ def main(argv=None, parser=None, measures_from_args=lambda args: ()) -> dict:
         args.layouts = layouts_lib.fig1b_candidates()
     if not args.layouts and not args.layout_file:
         parser.error("nothing to compare: give --layouts and/or --layout-file")
+    outputs.check_directory(args.out)
     start = time.perf_counter()
     cases = make_cases(args.layouts, args.layout_file, args.stiffness)
     options = Options(args.random_samples, args.seek_time, args.seed, not args.no_movement, args.out,

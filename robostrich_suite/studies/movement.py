@@ -20,6 +20,7 @@ import numpy as np
 from dm_control.rl import control as control_lib
 
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import outputs
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite import scenes
@@ -410,6 +411,7 @@ def build_parser() -> cli_lib.Parser:
 def main(argv=None) -> dict:
     """Command line: run both patterns, write a PNG and a Rerun recording of each."""
     args = build_parser().parse_args(argv)
+    outputs.check_directory(args.out)
     overrides = {} if args.joint_stiffness is None else {"joint_stiffness": args.joint_stiffness}
     spec = arm_lib.ArmSpec.from_table1(**overrides)
     setting = dict(ventral_span=args.ventral_span, dorsal=args.dorsal, amplitude=args.amplitude,

@@ -22,6 +22,7 @@ import numpy as np
 
 from robostrich_suite import files
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import outputs
 from robostrich_suite import targets
 from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite.studies import pose_seek, workspace
@@ -63,6 +64,9 @@ def generate(num_samples: int, seed: int = 0, path: pathlib.Path = targets.DATA_
         raise ValueError("nothing to draw: give samples and/or blue samples")
     samples = workspace.ActuatedSamples.concatenate(parts)
     level = samples.level()
+    if not level.any():  # a target file of no pose would fail every task that loads it
+        raise ValueError(f"none of the {len(level)} poses drawn holds the head level: nothing written to {path}; "
+                         "draw more (--samples, --blue-samples) or tune towards level (--seek-level-time)")
     new = dict(head_position=samples.head_position[level],
                head_attitude=samples.head_attitude[level], control=samples.control[level])
     if old is not None:
@@ -129,6 +133,8 @@ def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str) -> int:
     """Write ``poses`` (``head_position``, ``head_attitude``, ``control``) as a target file
     of the arm with ``fingerprint``; returns how many.  Readers of ``path`` see the new file."""
     path = pathlib.Path(path)
+    if not len(poses["head_position"]):
+        raise ValueError(f"no level-head pose to write to {path}: a target file holds at least one")
     path.parent.mkdir(parents=True, exist_ok=True)
     with files.replaced_atomically(path) as handle:  # whole or not at all (Ctrl-C, a full disk)
         np.savez_compressed(handle, fingerprint=np.array(fingerprint),
@@ -160,6 +166,7 @@ def main(argv=None) -> None:
     parser.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS), default=2,
                         help="processes drawing poses (default: %(default)s)")
     args = parser.parse_args(argv)
+    outputs.check_file(args.out)
     layout = None
     if args.layout is not None:
         from robostrich_suite.model import layouts

@@ -18,6 +18,7 @@ import numpy as np
 
 import robostrich_suite
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import outputs
 from robostrich_suite import physics as physics_lib
 from robostrich_suite import rerun_log
 from robostrich_suite.robostrich_a1 import CONTROL_TIMESTEP, SUITE
@@ -151,6 +152,7 @@ def main(argv=None) -> None:
     parser.add_argument("--seed", type=cli_lib.seed, default=0,
                         help="random seed of the episode (default: %(default)s)")
     args = parser.parse_args(argv)
+    outputs.check_directory(args.out)
     problem = out_directory_problem(args.out)
     if problem:
         parser.error(f"argument --out: {problem}")

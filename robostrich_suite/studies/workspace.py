@@ -24,6 +24,7 @@ import numpy as np
 
 from robostrich_suite import files
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import outputs
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite import fingerprint as fingerprint_lib
@@ -293,6 +294,7 @@ def main(argv=None) -> dict:
     args = parser.parse_args(argv)
     if args.samples + args.edge_samples == 0:
         parser.error("argument --samples: --samples and --edge-samples are both 0: no kinematic workspace to draw")
+    outputs.check_directory(args.out)
 
     start = time.perf_counter()
     physics = scenes.frame_physics()
