@@ -215,25 +215,6 @@ def test_torn_and_damaged_metrics_lines(tmp_path):
         read_records(str(path))
 
 
-def test_ctrl_c_stops_a_long_command_with_130_and_nothing_half_written(tmp_path):
-    """Stopped while they stream a Rerun recording, the commands leave no .rrd (nor its partial file).
-    The first rollout (the recorded one) lasts 300 s of simulation, so the stop always lands in it."""
-    commands = {"stabilize": ("robostrich-stabilize", "--seeds", "200", "--time-limit", "300", "--no-progress",
-                              "--no-figures"),
-                "walk": ("robostrich-walk", "--seconds", "300")}
-    processes = {name: start(*command, "--out", tmp_path / name) for name, command in commands.items()}
-    for name, process in processes.items():
-        out = tmp_path / name
-        wait_for(lambda: (out.exists() and any(out.iterdir())) or process.poll() is not None, "the recording")
-    time.sleep(1.0)
-    for name, process in processes.items():
-        process.send_signal(signal.SIGINT)
-        result = finish(process)
-        assert result.returncode == 130, result.stderr[-3000:]
-        assert result.stderr.strip().splitlines()[-1] == f"robostrich-{name}: interrupted", result.stderr
-        assert os.listdir(tmp_path / name) == []  # no report, no half-written recording
-
-
 def test_sigterm_is_handled_as_ctrl_c_checkpoint_written_and_143(tmp_path):
     """A batch scheduler stops a job with SIGTERM: training writes its checkpoint and exits 143 with one line."""
     out = tmp_path / "run"

@@ -145,7 +145,8 @@ def test_a_full_disk_is_one_line_naming_the_file_and_leaves_no_partial_file(tmp_
     then exit 1); training's checkpoints failed without a file name. Now: exit 2, one line naming
     the file, and no partial file anywhere."""
     processes = {
-        "walk": (start_with_a_full_disk("robostrich-walk", "--seconds", "2", "--out", tmp_path / "walk"),
+        "walk": (start_with_a_full_disk("robostrich-walk", "--seconds", "2", "--no-progress",
+                                         "--out", tmp_path / "walk"),
                  ["File too large", str(tmp_path / "walk" / "walk.rrd")]),
         "play": (start_with_a_full_disk("robostrich-play", "--num-targets", "1", "--out", tmp_path / "play"),
                  ["File too large", str(tmp_path / "play" / "policy_track.rrd")]),

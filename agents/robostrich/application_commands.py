@@ -48,6 +48,13 @@ def _setup(args):
     return gait, policies
 
 
+def _progress(args, policies, task: str):
+    """The bar over every rollout (robostrich_suite/progress.py: cleared if the command stops early)."""
+    from robostrich_suite import progress
+    return progress.bar(not args.no_progress, total=len(policies) * args.seeds, desc=task, unit="rollout",
+                        dynamic_ncols=True)
+
+
 def _meta(args, task: str, policies) -> dict:
     domain = policies[-1].domain
     return {"task": task, "domain": domain.name, "layout": domain.layout, "seeds": args.seeds,
@@ -131,12 +138,9 @@ def stabilize_main(argv=None) -> dict:
     gait, policies = _setup(args)
     task_kwargs = {k: v for k, v in (("time_limit", args.time_limit), ("distance", args.distance),
                                      ("height", args.height)) if v is not None}
-    bar = applications.progress(len(policies) * args.seeds, "head_stabilize", not args.no_progress)
-    try:
+    with _progress(args, policies, "head_stabilize") as bar:
         results = stabilization.evaluate(policies, args.seeds, gait, args.settle,
                                          None if args.no_rerun else args.out, bar, **task_kwargs)
-    finally:
-        bar.close()
     meta = {**_meta(args, stabilization.TASK, policies), "settled_from_s": args.settle,
             "goals": {k: {"goal": g, "kind": kind} for k, (g, kind) in stabilization.GOALS.items()}}
     results, series = _split_series(results)
@@ -188,11 +192,8 @@ def gap_main(argv=None) -> dict:
     gait, policies = _setup(args)
     task_kwargs = {k: v for k, v in (("time_limit", args.time_limit), ("steps_per_target", args.steps_per_target),
                                      ("switch", args.switch)) if v is not None}
-    bar = applications.progress(len(policies) * args.seeds, "narrow_gap", not args.no_progress)
-    try:
+    with _progress(args, policies, "narrow_gap") as bar:
         results = gap.evaluate(policies, args.seeds, gait, None if args.no_rerun else args.out, bar, **task_kwargs)
-    finally:
-        bar.close()
     env = applications.make_environment(policies[-1].domain, gap.TASK, 0, 1, gait, **task_kwargs)
     targets, tolerance = env.task.world_targets, env.task.position_tolerance
     rule = (f"every {env.task.steps_per_target} control steps ({env.task.steps_per_target * CONTROL_TIMESTEP:.2f} s), the same "

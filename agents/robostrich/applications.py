@@ -166,17 +166,3 @@ def rollouts(policy: Policy, task: str, seeds: int, gait, record_for: Callable,
         if bar is not None:
             bar.update(1)
 
-
-def progress(total: int, desc: str, enabled: bool = True):
-    """A tqdm bar over rollouts (stderr), or a stand-in that does nothing."""
-    if enabled:
-        from tqdm import tqdm
-        return tqdm(total=total, desc=desc, unit="rollout", dynamic_ncols=True)
-
-    class _Silent:
-        def update(self, n=1): pass
-
-        def set_postfix_str(self, s): pass
-
-        def close(self): pass
-    return _Silent()

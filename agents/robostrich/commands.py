@@ -51,7 +51,22 @@ def launch(prog: str) -> int:
         terminated = interrupted[-1] == signal.SIGTERM
         print(f"{prog}: {'terminated' if terminated else 'interrupted'}", file=sys.stderr)
         return TERMINATED if terminated else INTERRUPTED
-    return cli()
+    try:
+        return cli()
+    except KeyboardInterrupt:  # in the instant between the command's end and its own handling
+        _ignore_stop_signals()
+        print(f"{prog}: interrupted", file=sys.stderr)
+        return INTERRUPTED
+    finally:
+        _ignore_stop_signals()
+
+
+def _ignore_stop_signals() -> None:
+    """The command is done and its status set: a stop while the interpreter shuts down (JAX, Rerun,
+    a fraction of a second) changes nothing. Python puts back the default handlers of signals it
+    handles as it exits, and the default would end the process by the signal, with no line."""
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, signal.SIG_IGN)
 
 
 def _entry(prog: str):

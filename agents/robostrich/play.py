@@ -3,7 +3,8 @@
 Runs a policy file (robostrich_suite.policies; default: the default robot's curriculum
 policy) on the held-out targets from the fixed start, then on the frame's `track` task or, for a
 policy of the arm on the quadruped, on `head_stabilize` (Fig. 9, one gait phase); prints its
-success, and writes the reports, a Rerun recording of the second task and its figure.
+success, and writes the reports, a Rerun recording of the second task and its figure. Each line
+is printed as its part ends (flushed: a pipe, `| tee`, sees it then).
 """
 import os
 
@@ -35,7 +36,7 @@ def play_track(policy, domain, args) -> tuple:
     with open_recorder(None if args.no_rerun else os.path.join(args.out, written[-1]), f"{LABEL} track") as recorder:
         report = evaluation.evaluate_track(policy, policy.flatten, domain, TRACK_TASK, recorder=recorder)
     figures.plot_track({LABEL: report}, os.path.join(args.out, written[0]))
-    print(_line("track", report["summary"]))
+    print(_line("track", report["summary"]), flush=True)
     return report, written
 
 
@@ -48,7 +49,7 @@ def play_stabilize(policy, domain, args) -> tuple:
     written = [f"{LABEL}_stabilize.png"] + ([] if args.no_rerun else [f"stabilize_{LABEL}.rrd"])
     application_figures.stabilization_figure(results, os.path.join(args.out, written[0]), stabilization.SETTLE)
     metrics = {k: v for k, v in results[LABEL]["seeds"][0].items() if k != "seed"}
-    print(_stabilize_line(metrics))
+    print(_stabilize_line(metrics), flush=True)
     return {"summary": metrics, "goals": results[LABEL]["goals"]}, written
 
 
@@ -73,15 +74,15 @@ def main(argv=None) -> dict:
     env.close()
     os.makedirs(args.out, exist_ok=True)
     print(f"{args.policy} ({domain.describe()}, seed {policy.info.get('seed')}, "
-          f"{policy.info.get('env_steps')} control steps of training)")
+          f"{policy.info.get('env_steps')} control steps of training)", flush=True)
     reports = {"heldout": evaluation.evaluate_heldout(policy, policy.flatten, domain, heldout_task, args.num_targets)}
-    print(_line("heldout", reports["heldout"]["summary"]))
+    print(_line("heldout", reports["heldout"]["summary"]), flush=True)
     second, play = ("head_stabilize", play_stabilize) if domain.on_quadruped else ("track", play_track)
     reports[second], written = play(policy, domain, args)
     for kind, report in reports.items():
         report.update(label=LABEL, policy=args.policy)
         evaluation.write_json(os.path.join(args.out, f"{LABEL}_{kind}.json"), report)
-    print(f"wrote {args.out}/: reports, {', '.join(written)}")
+    print(f"wrote {args.out}/: reports, {', '.join(written)}", flush=True)
     return reports
 
 

@@ -607,13 +607,24 @@ def _train_in_parallel(specs: dict, job: RunJob, progress, workers: int) -> dict
                 os.environ.pop("XLA_FLAGS", None)
             else:
                 os.environ["XLA_FLAGS"] = saved
-    for kind, error in (("error", RuntimeError), ("user_error", ValueError), ("interrupted", KeyboardInterrupt)):
+    for kind, error in (("error", RuntimeError), ("user_error", ValueError)):
         if ends[kind]:
             raise error("; ".join(f"{label}: {message}" for label, message in ends[kind].items()))
+    if ends["interrupted"]:
+        raise KeyboardInterrupt(_stopped_workers(ends["interrupted"]))
     outcomes = ends["done"]
     for label, outcome in outcomes.items():
         outcome["reports"] = evaluation.read_reports(job.out_eval, label)
     return outcomes
+
+
+def _stopped_workers(stopped: dict) -> str:
+    """The interrupt's message from the workers' (label -> message): the checkpoints they wrote
+    first, 'checkpoint written at step N: PATH; at step M: PATH', as the command's line shows one."""
+    written = cli_lib.CHECKPOINT_WRITTEN
+    saved = [message[len(written):].strip() for message in stopped.values() if message.startswith(written)]
+    others = [f"{label}: {message}" for label, message in stopped.items() if message and not message.startswith(written)]
+    return "; ".join(([f"{written} " + "; ".join(saved)] if saved else []) + others)
 
 
 def _supervise(context, specs, job, progress, workers, queue, active, ends):

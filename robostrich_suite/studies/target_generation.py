@@ -22,7 +22,8 @@ import numpy as np
 
 from robostrich_suite import files
 from robostrich_suite import cli as cli_lib
-from robostrich_suite import outputs
+from robostrich_suite import outputs, parallel
+from robostrich_suite import progress as progress_lib
 from robostrich_suite import targets
 from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite.studies import pose_seek, workspace
@@ -91,9 +92,7 @@ def seek_blue_region(kinematic_samples: int, seed: int = 0, workers: int = 2, sp
         raise ValueError(f"no level head among {kinematic_samples} kinematic samples; draw more")
     if len(chunks) == 1:
         return _seek_chunk(chunks[0])
-    from concurrent.futures import ProcessPoolExecutor
-    with ProcessPoolExecutor(len(chunks)) as pool:
-        return workspace.ActuatedSamples.concatenate(list(pool.map(_seek_chunk, chunks)))
+    return workspace.ActuatedSamples.concatenate(parallel.map_processes(_seek_chunk, chunks))
 
 
 def recheck(path: pathlib.Path, spec=None, layout=None, settle_time: float = pose_seek.HOLD_TIME,
@@ -111,14 +110,13 @@ def recheck(path: pathlib.Path, spec=None, layout=None, settle_time: float = pos
     count = len(poses["control"])
     held = workspace.ActuatedSamples(np.zeros((count, 2)), np.zeros(count), np.array(poses["control"]),
                                      np.zeros(count, bool))
-    iterator = range(count)
-    if progress:
-        from tqdm import tqdm
-        iterator = tqdm(iterator, desc="recheck", unit="pose", mininterval=1.0)
-    for i in iterator:
-        held.settled[i] = workspace.settle(physics, held.control[i], settle_time)
-        held.head_position[i] = physics.head_position()[[0, 2]]
-        held.head_attitude[i] = physics.head_attitude()
+    with progress_lib.bar(progress, total=count, desc="recheck", unit="pose", mininterval=1.0) as bar:
+        for i in range(count):
+            held.settled[i] = workspace.settle(physics, held.control[i], settle_time)
+            held.head_position[i] = physics.head_position()[[0, 2]]
+            held.head_attitude[i] = physics.head_attitude()
+            if bar is not None:
+                bar.update()
     level = held.level()  # the level rule every target file is made with
     kept = dict(head_position=held.head_position[level], head_attitude=held.head_attitude[level],
                 control=held.control[level])

@@ -19,6 +19,7 @@ import numpy as np
 import robostrich_suite
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs
+from robostrich_suite import progress as progress_lib
 from robostrich_suite import physics as physics_lib
 from robostrich_suite import rerun_log
 from robostrich_suite.robostrich_a1 import CONTROL_TIMESTEP, SUITE
@@ -43,8 +44,9 @@ def scripted_tendons(kind: str, control_range: np.ndarray, dorsal: int):
 
 
 def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendons: str = "zero",
-                gait=None, rrd_path=None, seed: int = 0) -> dict:
-    """Run ``task_name`` with scripted tendons; returns the time series (and writes an .rrd).
+                gait=None, rrd_path=None, seed: int = 0, progress: bool = False) -> dict:
+    """Run ``task_name`` with scripted tendons; returns the time series (and writes an .rrd),
+    with a progress bar over the steps if ``progress``.
 
     Series: ``time``, ``trunk_height``, ``height_command``, ``head_height``,
     ``trunk_speed`` (forward), ``head_speed`` (3-D), ``head_vertical_speed``,
@@ -62,14 +64,19 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
                               physics_lib.dorsal_index(physics.model))
     steps = int(round(seconds / CONTROL_TIMESTEP))
     if rrd_path is None:
-        return _walk(env, script, steps, None)
+        return _walk(env, script, steps, None, progress)
     with rerun_log.recording("robostrich_a1_walk", pathlib.Path(rrd_path)) as rec:
         rerun_log.log_geometry(rec, physics)
-        return _walk(env, script, steps, rec)
+        return _walk(env, script, steps, rec, progress)
 
 
-def _walk(env, script, steps: int, rec) -> dict:
+def _walk(env, script, steps: int, rec, progress: bool) -> dict:
     """`steps` control steps of `script`'s tendon inputs: the series of record_walk, logged to `rec`."""
+    with progress_lib.bar(progress, total=steps, desc="walk", unit="step", mininterval=0.5) as bar:
+        return _walk_steps(env, script, steps, rec, bar)
+
+
+def _walk_steps(env, script, steps: int, rec, bar) -> dict:
     physics = env.physics
     series = collections.defaultdict(list)
     head_path = []
@@ -101,6 +108,8 @@ def _walk(env, script, steps: int, rec) -> dict:
             rerun_log.log_scalars(rec, "plots", {k: v for k, v in values.items() if k != "time"})
             if i % 10 == 0:
                 rerun_log.log_path(rec, "world/head_path", head_path)
+        if bar is not None:
+            bar.update()
         if step.last():
             break
     return {key: np.array(value) for key, value in series.items()}
@@ -149,6 +158,7 @@ def main(argv=None) -> None:
                         help="output directory: writes OUT/walk.rrd and OUT/walk.png "
                              "(default: %(default)s)")
     parser.add_argument("--no-rrd", action="store_true", help="skip the Rerun recording")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--seed", type=cli_lib.seed, default=0,
                         help="random seed of the episode (default: %(default)s)")
     args = parser.parse_args(argv)
@@ -158,7 +168,7 @@ def main(argv=None) -> None:
         parser.error(f"argument --out: {problem}")
     gait = gait_lib.TrotGait() if args.gait == "trot" else args.gait
     rrd = None if args.no_rrd else args.out / "walk.rrd"
-    series = record_walk(args.task, args.seconds, args.tendons, gait, rrd, args.seed)
+    series = record_walk(args.task, args.seconds, args.tendons, gait, rrd, args.seed, progress=not args.no_progress)
     png = args.out / "walk.png"
     walk_figure.plot_walk(series, png, f"robostrich_a1/{args.task}, tendons: {args.tendons}")
     walked = np.sum(series["trunk_speed"]) * CONTROL_TIMESTEP

@@ -24,7 +24,8 @@ import numpy as np
 
 from robostrich_suite import files
 from robostrich_suite import cli as cli_lib
-from robostrich_suite import outputs
+from robostrich_suite import outputs, parallel
+from robostrich_suite import progress as progress_lib
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite import fingerprint as fingerprint_lib
@@ -38,6 +39,7 @@ SETTLE_TIME = LESSON_TIME_LIMIT
 # Joint limits are soft constraints (arm.ArmSpec.limit_solref): a settled pose may
 # sit slightly past Table 1.  Measured over 1200 random tendon inputs: at most 0.8 deg.
 LIMIT_TOLERANCE_DEG = 1.0
+ACTUATED = "actuated workspace"  # the progress bar of the held-input draw
 
 
 def base_joint_xz(physics: scenes.FramePhysics, spec: arm_lib.ArmSpec | None = None) -> np.ndarray:
@@ -110,15 +112,14 @@ def kinematic_samples(num_samples: int, seed: int = 0, spec: arm_lib.ArmSpec | N
     qpos_adr, site, head_body = indices.qpos, indices.head_site, indices.head_body
     positions = np.empty((total, 2))
     axes = np.empty((total, 2))
-    iterator = range(total)
-    if progress:
-        from tqdm import tqdm
-        iterator = tqdm(iterator, desc="kinematic workspace", unit="pose", mininterval=1.0)
-    for i in iterator:
-        data.qpos[qpos_adr] = angles[i]
-        mujoco.mj_kinematics(model, data)
-        positions[i] = data.site_xpos[site, [0, 2]]
-        axes[i] = data.xmat[head_body, [2, 8]]  # head z axis: world x and z components
+    with progress_lib.bar(progress, total=total, desc="kinematic workspace", unit="pose", mininterval=1.0) as bar:
+        for i in range(total):
+            data.qpos[qpos_adr] = angles[i]
+            mujoco.mj_kinematics(model, data)
+            positions[i] = data.site_xpos[site, [0, 2]]
+            axes[i] = data.xmat[head_body, [2, 8]]  # head z axis: world x and z components
+            if bar is not None:
+                bar.update()
     attitudes = physics_lib.continuous_attitude_deg(np.degrees(np.arctan2(axes[:, 0], axes[:, 1])), angles)
     uniform = np.arange(total) < num_samples
     return KinematicSamples(angles, positions, attitudes, uniform)
@@ -201,24 +202,24 @@ def actuated_samples(num_samples: int, seed: int = 0, settle_time: float = SETTL
     attitudes = np.zeros(num_samples)
     settled = np.zeros(num_samples, bool)
     angles = np.zeros((num_samples, spec.num_joints))
-    iterator = range(num_samples)
-    if progress:
-        from tqdm import tqdm
-        iterator = tqdm(iterator, desc="actuated workspace", unit="pose")
-    for i in iterator:
-        if seek_level_time > 0:
-            controls[i] = seek_level(physics, controls[i], seek_level_time)
-        settled[i] = settle(physics, controls[i], settle_time)
-        positions[i] = physics.head_position()[[0, 2]]
-        attitudes[i] = physics.head_attitude()
-        angles[i] = physics.joint_angles()
+    with progress_lib.bar(progress, total=num_samples, desc=ACTUATED, unit="pose") as bar:
+        for i in range(num_samples):
+            if seek_level_time > 0:
+                controls[i] = seek_level(physics, controls[i], seek_level_time)
+            settled[i] = settle(physics, controls[i], settle_time)
+            positions[i] = physics.head_position()[[0, 2]]
+            attitudes[i] = physics.head_attitude()
+            angles[i] = physics.joint_angles()
+            parallel.count()  # the parent's bar, in a worker of actuated_samples_parallel
+            if bar is not None:
+                bar.update()
     return ActuatedSamples(positions, attitudes, controls, settled, angles)
 
 
 def _actuated_chunk(args) -> ActuatedSamples:
-    num, seed, settle_time, progress, seek_level_time, spec, layout = args
-    return actuated_samples(num, seed=seed, settle_time=settle_time, progress=progress,
-                            seek_level_time=seek_level_time, spec=spec, layout=layout)
+    num, seed, settle_time, seek_level_time, spec, layout = args
+    return actuated_samples(num, seed=seed, settle_time=settle_time, seek_level_time=seek_level_time,
+                            spec=spec, layout=layout)
 
 
 def actuated_samples_parallel(num_samples: int, seed: int = 0, settle_time: float = SETTLE_TIME,
@@ -226,17 +227,17 @@ def actuated_samples_parallel(num_samples: int, seed: int = 0, settle_time: floa
                               seek_level_time: float = 0.0,
                               spec: arm_lib.ArmSpec | None = None,
                               layout: arm_lib.TendonLayout | None = None) -> ActuatedSamples:
-    """:func:`actuated_samples` split over processes (chunk ``i`` uses seed ``seed + i``)."""
+    """:func:`actuated_samples` split over processes (chunk ``i`` uses seed ``seed + i``), with
+    one progress bar over all of them (robostrich_suite/parallel.py)."""
     if workers <= 1:
         return actuated_samples(num_samples, seed, settle_time, progress=progress,
                                 seek_level_time=seek_level_time, spec=spec, layout=layout)
-    from concurrent.futures import ProcessPoolExecutor
     chunk = -(-num_samples // workers)
     sizes = [min(chunk, num_samples - i * chunk) for i in range(workers)]
-    jobs = [(size, seed + i, settle_time, progress and i == 0, seek_level_time, spec, layout)
+    jobs = [(size, seed + i, settle_time, seek_level_time, spec, layout)
             for i, size in enumerate(sizes) if size > 0]
-    with ProcessPoolExecutor(len(jobs)) as pool:
-        return ActuatedSamples.concatenate(list(pool.map(_actuated_chunk, jobs)))
+    with progress_lib.bar(progress, total=num_samples, desc=ACTUATED, unit="pose") as bar:
+        return ActuatedSamples.concatenate(parallel.map_processes(_actuated_chunk, jobs, bar))
 
 
 # --------------------------------------------------------------------------- figure, files

@@ -1,0 +1,183 @@
+"""Ctrl-C and SIGTERM as a user or a batch scheduler sends them, at moments the commands mark in
+their own output (never after a fixed sleep): every stop ends with the command's one line
+(`robostrich-X: interrupted`, 130; `terminated`, 143) and nothing else on the screen, or, once the
+command is done, with its success; never by the signal itself.
+
+Commands run as installed scripts (conftest.console_script), their output read as it comes.
+"""
+import os
+import pathlib
+import signal
+import subprocess
+import threading
+import time
+
+import pytest
+
+import conftest
+from agents import checkpoint
+
+pytestmark = pytest.mark.usefixtures("shared_jax_cache")
+
+
+class Running:
+    """An installed command whose stdout and stderr are read as they come (threads), so the test
+    can wait for a line, a progress bar or a file before it sends a signal."""
+
+    def __init__(self, name, *args, new_session=False):
+        self.name = name
+        self.process = subprocess.Popen([conftest.console_script(name), *map(str, args)], stdout=subprocess.PIPE,
+                                        stderr=subprocess.PIPE, env=conftest.COMMAND_ENVIRONMENT,
+                                        start_new_session=new_session)
+        self.out, self.err = bytearray(), bytearray()
+        self.readers = [threading.Thread(target=self._read, args=(stream, into), daemon=True)
+                        for stream, into in ((self.process.stdout, self.out), (self.process.stderr, self.err))]
+        for reader in self.readers:
+            reader.start()
+
+    @staticmethod
+    def _read(stream, into: bytearray):
+        for chunk in iter(lambda: stream.read1(65536), b""):
+            into.extend(chunk)
+
+    def wait_for(self, condition, what: str, timeout: float = 400):
+        deadline = time.monotonic() + timeout
+        while not condition():
+            assert self.process.poll() is None, f"{self.name} ended ({self.process.returncode}) before {what}: " \
+                                                f"{self.stderr[-3000:]}"
+            assert time.monotonic() < deadline, f"timed out waiting for {what}"
+            time.sleep(0.05)
+
+    def wait_for_output(self, text: str, stream: str = "stdout", timeout: float = 400):
+        self.wait_for(lambda: text in getattr(self, stream), f"{text!r} on {stream}", timeout)
+
+    def finish(self, timeout: float = 600) -> int:
+        try:
+            self.process.wait(timeout)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            raise
+        for reader in self.readers:
+            reader.join(10)
+        return self.process.returncode
+
+    @property
+    def stdout(self) -> str:
+        return self.out.decode(errors="replace")
+
+    @property
+    def stderr(self) -> str:
+        return self.err.decode(errors="replace")
+
+    def shown_lines(self) -> list:
+        """stderr as a terminal shows it: each line's text after its last carriage return (where a
+        progress bar redraws itself), blank ones left out."""
+        return [shown for shown in (line.rsplit("\r", 1)[-1].rstrip() for line in self.stderr.split("\n")) if shown]
+
+
+def assert_stopped(command: Running, status: int, word: str):
+    returncode = command.finish()
+    assert returncode == status, (returncode, command.stderr[-3000:])
+    assert command.shown_lines() == [f"{command.name}: {word}"], command.stderr[-3000:]
+
+
+TRAIN = ["--plan", "lesson1:2900,lesson2:2900", "--hidden-sizes", "16,16", "--batch-size", "16",
+         "--min-replay-size", "50", "--num-eval-targets", "1", "--final-eval-targets", "1", "--eval-every", "5800",
+         "--track-task", "", "--quiet", "--no-rerun", "--no-figures"]
+
+
+@pytest.mark.parametrize("stop, status, word", [(signal.SIGINT, 130, "interrupted"),
+                                                (signal.SIGTERM, 143, "terminated")], ids=["ctrl_c", "sigterm"])
+def test_training_with_two_workers_names_the_checkpoints_they_wrote(tmp_path, stop, status, word):
+    """The parent's one line says where each worker's checkpoint went, as a run trained in one
+    process says where its went. Stopped once both runs are mid-training (each has an episode
+    recorded) and with 5,800 steps to go, so both always write one."""
+    out = tmp_path / "run"
+    command = Running("robostrich-train", *TRAIN, "--out", out)
+    metrics = [out / label / "metrics.jsonl" for label in ("curriculum", "baseline")]
+    command.wait_for(lambda: all(p.exists() and p.stat().st_size > 0 for p in metrics), "an episode of each run")
+    command.process.send_signal(stop)
+    returncode = command.finish()
+    assert returncode == status, command.stderr[-3000:]
+    lines = command.stderr.strip().splitlines()
+    assert lines[-1].startswith(f"robostrich-train: {word} (checkpoint written at step "), command.stderr[-3000:]
+    for label in ("curriculum", "baseline"):
+        path = out / label / "checkpoint.ckpt"
+        steps = checkpoint._read_record(str(path))["payload"]["loop"]["env_steps"]
+        assert f"at step {steps}: {path}" in lines[-1], (steps, lines[-1])
+    assert "Traceback" not in command.stderr
+
+
+def test_play_ends_with_its_line_wherever_it_is_stopped_and_succeeds_once_done(tmp_path):
+    """Stopped while it evaluates the held-out targets (all of them: many seconds), while it runs
+    track, and from the moment it has written everything until it exits (the interpreter takes a
+    fraction of a second to shut down JAX and Rerun, with Python's default handlers back: a stop
+    there ended the process by the signal, with no line)."""
+    policy_line = "control steps of training)"
+    marks = {"heldout": (policy_line, []), "track": ("heldout ", ["--num-targets", "1"]),
+             "done": ("wrote ", ["--num-targets", "1"])}
+    for phase, (mark, args) in marks.items():
+        out = tmp_path / phase
+        command = Running("robostrich-play", "--out", out, *args)
+        command.wait_for_output(mark)
+        command.process.send_signal(signal.SIGINT)
+        if phase == "done":
+            while command.process.poll() is None:  # Ctrl-C pressed again and again as it shuts down
+                command.process.send_signal(signal.SIGINT)
+                time.sleep(0.02)
+            returncode = command.finish()
+            assert returncode in (0, 130), (returncode, command.stderr[-3000:])  # never by the signal (-2)
+            if returncode == 0:
+                assert command.stderr == "", command.stderr[-3000:]
+            else:
+                assert command.shown_lines() == ["robostrich-play: interrupted"], command.stderr[-3000:]
+            assert sorted(p.name for p in out.iterdir()) == ["policy_heldout.json", "policy_track.json",
+                                                             "policy_track.png", "policy_track.rrd"]
+        else:
+            assert_stopped(command, 130, "interrupted")
+            assert not list(out.glob("*.json")) and not list(out.glob(".*")), sorted(out.iterdir())
+
+
+@pytest.mark.parametrize("workers, whole_group", [(2, False), (2, True), (1, False)],
+                         ids=["to_the_command", "to_its_workers_too", "one_process"])
+def test_targets_clears_its_progress_bar_before_its_line_and_stops_at_once(tmp_path, workers, whole_group):
+    """Ctrl-C to the command alone or, as a terminal sends it, to its workers too: the bar is
+    cleared, the one line stands alone, the workers stop at once (a million draws would take
+    hours), none outlives the command, and no target file is written. The signal comes as soon as
+    the bar is drawn, while the workers may still be starting."""
+    out = tmp_path / "t.npz"
+    command = Running("robostrich-targets", "--samples", "1000000", "--workers", workers, "--out", out,
+                      new_session=True)
+    command.wait_for(lambda: "pose/s]" in command.stderr, "the progress bar")
+    if whole_group:
+        os.killpg(command.process.pid, signal.SIGINT)
+    else:
+        command.process.send_signal(signal.SIGINT)
+    started = time.monotonic()
+    try:
+        assert_stopped(command, 130, "interrupted")
+        assert time.monotonic() - started < 60
+        with pytest.raises(ProcessLookupError):  # no worker left in the command's process group
+            os.killpg(command.process.pid, 0)
+    finally:
+        try:
+            os.killpg(command.process.pid, signal.SIGKILL)  # whatever a failure left behind
+        except ProcessLookupError:
+            pass
+    assert not any(pathlib.Path(tmp_path).iterdir())
+
+
+def test_a_command_stopped_mid_recording_leaves_no_recording(tmp_path):
+    """Stopped while they record a rollout (kept in memory until it is whole, robostrich_suite/rerun_log.py),
+    stabilize and walk leave no .rrd, no partial file and no report. The recorded rollouts last 300 s
+    of simulation, so the stop always lands in them; walk's bar is drawn once its recording is open."""
+    commands = {"stabilize": Running("robostrich-stabilize", "--seeds", "200", "--time-limit", "300",
+                                     "--no-figures", "--out", tmp_path / "stabilize"),
+                "walk": Running("robostrich-walk", "--seconds", "300", "--out", tmp_path / "walk")}
+    commands["stabilize"].wait_for_output("head_stabilize:", "stderr")
+    commands["walk"].wait_for_output("walk:", "stderr")
+    for name, command in commands.items():
+        command.process.send_signal(signal.SIGINT)
+        assert_stopped(command, 130, "interrupted")
+        out = tmp_path / name
+        assert not out.exists() or os.listdir(out) == [], os.listdir(out)
