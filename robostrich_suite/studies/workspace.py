@@ -262,8 +262,8 @@ def save_samples(path: str | pathlib.Path, kinematic: KinematicSamples,
     return path
 
 
-def main(argv=None) -> dict:
-    """Command line: sample both workspaces, write the figure and the samples."""
+def build_parser() -> cli_lib.Parser:
+    """robostrich-workspace's flags."""
     parser = cli_lib.Parser(
         prog="robostrich-workspace",
         description="Kinematic workspace of the Robostrich arm (paper Fig. 6: red = all head "
@@ -292,6 +292,12 @@ def main(argv=None) -> dict:
     parser.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS), default=2,
                         help="processes for the actuated sampling (default: %(default)s)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    return parser
+
+
+def main(argv=None) -> dict:
+    """Command line: sample both workspaces, write the figure and the samples."""
+    parser = build_parser()
     args = parser.parse_args(argv)
     if args.samples + args.edge_samples == 0:
         parser.error("argument --samples: --samples and --edge-samples are both 0: no kinematic workspace to draw")
