@@ -343,11 +343,15 @@ def test_walk_tool_writes_a_recording_and_a_plot_into_its_out_directory(tmp_path
 def test_walk_tool_refuses_a_file_as_out(tmp_path, capsys, out):
     """The old usage (a file name) and an existing file get a usage error naming --out."""
     (tmp_path / "a_file").write_text("")
-    with pytest.raises(SystemExit) as exit_info:
-        walk.main(["--seconds", "0.1", "--no-rrd", "--out", str(tmp_path / out)])
-    assert exit_info.value.code == 2
-    last = capsys.readouterr().err.strip().splitlines()[-1]
-    assert "argument --out:" in last and "is a directory" in last
+    if out == "a_file":  # an existing file: the output check, before any work (robostrich_suite/outputs.py)
+        with pytest.raises(NotADirectoryError, match="--out .*a_file is a file, not a directory"):
+            walk.main(["--seconds", "0.1", "--no-rrd", "--out", str(tmp_path / out)])
+    else:
+        with pytest.raises(SystemExit) as exit_info:
+            walk.main(["--seconds", "0.1", "--no-rrd", "--out", str(tmp_path / out)])
+        assert exit_info.value.code == 2
+        last = capsys.readouterr().err.strip().splitlines()[-1]
+        assert "argument --out:" in last and "is a directory" in last
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
 
 

@@ -139,7 +139,7 @@ def measure(case: Case, region: coverage_lib.BlueRegion, options: Options, progr
     target_generation.save_level_poses(target_path, dict(head_position=held,
                                                head_attitude=samples.head_attitude[level],
                                                control=samples.control[level]),
-                             fingerprint_lib.model_fingerprint(case.spec, case.layout))
+                             fingerprint_lib.model_fingerprint(case.spec, case.layout), allow_empty=True)
     row = {"layout": case.label, "source": case.source,
            "joint_stiffness": case.spec.joint_stiffness, "tendons": len(case.layout),
            "blue_cells": region.num_cells, "covered_cells": int(covered.sum()),
