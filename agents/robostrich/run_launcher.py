@@ -5,7 +5,7 @@ SIGTERM: it writes its checkpoint, then exits.
 
 Ray's worker may SIGKILL its child processes and their process group when it exits (its driver
 killed, a node lost), which would stop a run without a checkpoint. So this launcher stands
-between them: it starts the command as its own child in a session of its own, out of reach of
+between them: it starts the command as its own child, detached by setsid() from the worker's process group, out of reach of
 those kills, and asks the kernel (PR_SET_PDEATHSIG) to send the command SIGTERM when the launcher
 dies, and the launcher SIGTERM when the worker dies. Ctrl-C or SIGTERM sent to the launcher (a
 cancelled task) is passed on; the launcher exits with the command's status (128 + N for signal N).
