@@ -10,6 +10,8 @@ setup(
     name="robostrich_suite",
     version="0.1.0",
     description="Simulation and curriculum-SAC learning for the tendon-driven Robostrich arm.",
+    license="Apache-2.0",  # the text: LICENSE (as dm_control, Acme and MuJoCo)
+    classifiers=["License :: OSI Approved :: Apache Software License"],
     python_requires=">=3.11",  # numpy 2.4, jax 0.10, scipy, matplotlib 3.11 and rerun-sdk 0.41 need 3.11
     packages=find_packages(include=["robostrich_suite", "robostrich_suite.*", "agents", "agents.*"]),
     package_data={"robostrich_suite": ["data/*", "data/policies/*"]},

@@ -14,7 +14,7 @@ def setup_arguments() -> dict:
     tree = ast.parse((ROOT / "setup.py").read_text())
     call = next(node for node in ast.walk(tree) if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "setup")
     return {kw.arg: ast.literal_eval(kw.value) for kw in call.keywords
-            if kw.arg in ("python_requires", "install_requires", "extras_require")}
+            if kw.arg in ("python_requires", "install_requires", "extras_require", "license", "classifiers")}
 
 
 def test_python_requires_is_what_the_pinned_dependencies_need():
@@ -40,6 +40,13 @@ def test_python_requires_is_what_the_pinned_dependencies_need():
     # ... and it is the tightest of them: python_requires claims no version none of them rules out.
     assert any(version.Version(f"{lowest.major}.{lowest.minor - 1}") not in specifiers.SpecifierSet(r)
                for r in needs.values()), (arguments["python_requires"], needs)
+
+
+def test_the_licence_is_declared_and_shipped():
+    arguments = setup_arguments()
+    assert arguments["license"] == "Apache-2.0"
+    assert "License :: OSI Approved :: Apache Software License" in arguments["classifiers"]
+    assert "Apache License\n                           Version 2.0" in (ROOT / "LICENSE").read_text()
 
 
 def test_readme_states_the_same_python_version():
