@@ -80,3 +80,17 @@ def test_every_module_imports_with_the_agent_blocked():
 @pytest.mark.parametrize("module", ["robostrich_suite.model.arm", "robostrich_suite.physics"])
 def test_layer_map_is_not_vacuous(module):
     assert layer_of(module) in ("model", "physics")
+
+
+def test_a_figure_module_imports_nothing_of_its_study():
+    """A study imports its figure module, never the reverse (no loop: the figure reads the study's results)."""
+    figures = {m: p for m, p in modules() if m.startswith("robostrich_suite.studies.") and m.endswith("_figure")}
+    assert "robostrich_suite.studies.movement_figure" in figures and "robostrich_suite.studies.workspace_figure" in figures
+    loops = [f"{m} imports {t}" for m, p in figures.items() for t in imported(p) if t == m.removesuffix("_figure")]
+    assert not loops, "\n".join(loops)
+
+
+def test_tools_find_the_packages_by_their_install():
+    """tools/ scripts import the installed packages (pip install -e .): none edits sys.path by hand."""
+    editing = [p.name for p in sorted((ROOT / "tools").glob("*.py")) if "sys.path" in p.read_text()]
+    assert not editing, editing

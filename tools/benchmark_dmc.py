@@ -16,8 +16,6 @@ import sys
 import time
 from collections import deque
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
 # PlaNet's action repeats, used by the state-SAC baselines of CURL/DrQ; budgets are this tool's defaults.
 ACTION_REPEAT = {"reacher/easy": 4, "cartpole/swingup": 8, "cheetah/run": 4, "finger/spin": 2,
                  "walker/walk": 2, "ball_in_cup/catch": 4}

@@ -16,22 +16,19 @@ Variants are measured in interleaved rounds, best round kept, so that other
 load on the machine biases the ratios as little as possible.
 """
 import argparse
-import os
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
 
-import jax  # noqa: E402
-import jax.numpy as jnp  # noqa: E402
-import numpy as np  # noqa: E402
-import optax  # noqa: E402
-
-from agents.robostrich.runs import make_environment  # noqa: E402
-from agents.sac.builder import SACBuilder  # noqa: E402
-from agents.sac.config import SACConfig  # noqa: E402
-from agents.sac.learning import SACLearner, Transitions, init_state  # noqa: E402
-from agents.sac.networks import make_networks  # noqa: E402
+from agents.robostrich.runs import make_environment
+from agents.sac.builder import SACBuilder
+from agents.sac.config import SACConfig
+from agents.sac.learning import SACLearner, Transitions, init_state
+from agents.sac.networks import make_networks
 
 
 def plain_sac(networks, config):

@@ -8,12 +8,9 @@ into OUT/runs/default/seed_K as Ray tasks, a finished seed is not re-run, a kill
 and OUT/sweep.md and OUT/sweep.json hold mean [min, max] over the seeds. The records in
 docs/results/ name this command. The aggregation lives in agents/robostrich/sweep_table.py.
 """
-import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from agents.robostrich.sweep_table import aggregate, format_table  # noqa: E402,F401  (tests and older callers)
+from agents.robostrich.sweep_table import aggregate, format_table  # noqa: F401  (tests and older callers)
 
 DEFAULT_OUT = "runs/seeds"
 

@@ -13,14 +13,11 @@ import argparse
 import glob
 import json
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from agents.robostrich import figures, sweep_table  # noqa: E402
-from agents.robostrich.runs import parse_plan  # noqa: E402
+from agents.robostrich import figures, sweep_table
+from agents.robostrich.runs import parse_plan
 
 KINDS = ("heldout", "heldout_moving")
 

@@ -7,14 +7,11 @@
 The file holds the actor's evaluation parameters, the observation layout, the action
 bounds, the model fingerprint and how the run was made (--command, its seed and plan).
 """
-import argparse
 import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-
-from agents.robostrich.policy_export import export_policy  # noqa: E402
-from robostrich_suite import cli as cli_lib  # noqa: E402
+from agents.robostrich.policy_export import export_policy
+from robostrich_suite import cli as cli_lib
 
 
 def main(argv=None):

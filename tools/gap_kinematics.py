@@ -24,12 +24,10 @@ The neck's geometry is robostrich_suite/studies/gap_column.py's, which robostric
 import argparse
 import json
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from robostrich_suite.studies.gap_column import SAMPLES_PER_CAPSULE  # noqa: E402  (points per capsule)
+from robostrich_suite.studies.gap_column import SAMPLES_PER_CAPSULE  # points per capsule
 
 LEVEL_TOLERANCE = 5.0  # deg, as the tasks' attitude tolerance
 AGREEMENT = 0.02  # m: poses "agree" up to the last neck point where 95 % of them lie within this of their mean

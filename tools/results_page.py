@@ -41,11 +41,10 @@ import results_layouts
 import results_robustness
 import results_seeds
 import results_speed
+from robostrich_suite import files  # the project's one atomic writer
+from robostrich_suite import parsing  # JSON read with a depth limit, errors naming the file
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from robostrich_suite import files  # noqa: E402  (the project's one atomic writer)
-from robostrich_suite import parsing  # noqa: E402  (JSON read with a depth limit, errors naming the file)
 
 RECORDS = ROOT / "docs" / "results"
 PAGE = ROOT / "docs" / "results.md"

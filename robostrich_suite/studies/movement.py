@@ -24,6 +24,7 @@ from robostrich_suite import outputs
 from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite import scenes
+from robostrich_suite.studies import movement_figure
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
 
 PATTERNS = ("rolling", "lever")
@@ -141,6 +142,11 @@ class Movement:
     head_attitude: np.ndarray  # (n,) deg
     joint_points: np.ndarray  # (n, num_joints + 1, 2): base joint ... atlas joint, head tip
     ventral_amplitudes: np.ndarray  # (num_ventral,) m, each ventral tendon's peak input
+
+    @property
+    def settle_time(self) -> float:
+        """Seconds before the ventral ramps start (the start pose coming to rest)."""
+        return SETTLE_TIME
 
     @property
     def moving(self) -> np.ndarray:
@@ -441,7 +447,6 @@ def main(argv=None) -> dict:
 def run_patterns(args, base: MovementConfig, spec) -> tuple[dict, list]:
     """Each pattern of ``args.patterns`` (rolling first: the lever matches its head travel), with
     its figure and recording; prints a line per pattern and the ratio. Returns (results, files)."""
-    from robostrich_suite.studies import movement_figure
     progress = not args.no_progress
     written, results = [], {}
     for pattern in sorted(args.patterns, key=PATTERNS.index):

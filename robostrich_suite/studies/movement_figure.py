@@ -1,5 +1,6 @@
 """Figs. 4-5 of a movement test (:mod:`robostrich_suite.studies.movement`): tendon inputs,
-head attitude and stick figures of the arm.  Plotting only; the movement computes nothing here."""
+head attitude and stick figures of the arm.  Plotting only; the movement computes nothing here.
+It reads a finished ``movement.Movement`` and imports nothing of the study (the study imports it)."""
 from __future__ import annotations
 
 import pathlib
@@ -7,10 +8,9 @@ import pathlib
 import numpy as np
 
 from robostrich_suite import files
-from robostrich_suite.studies import movement as movement_lib
 
 
-def movement_figure(movement: movement_lib.Movement, num_sticks: int = 12):
+def movement_figure(movement, num_sticks: int = 12):
     """Figs. 4-5 as a matplotlib Figure: (A) tendon inputs, (B) head attitude, (C) the arm."""
     import matplotlib
     matplotlib.use("Agg")
@@ -30,7 +30,7 @@ def movement_figure(movement: movement_lib.Movement, num_sticks: int = 12):
     return fig
 
 
-def _plot_inputs(ax, movement: movement_lib.Movement) -> None:
+def _plot_inputs(ax, movement) -> None:
     import matplotlib.pyplot as plt
     colors = plt.cm.viridis(np.linspace(0, 0.95, len(movement.tendon_names)))
     for i, name in enumerate(movement.tendon_names):
@@ -52,9 +52,9 @@ def _plot_inputs(ax, movement: movement_lib.Movement) -> None:
                  f"{movement.amplitude_text()}", fontsize=10)
 
 
-def _plot_attitude(ax, movement: movement_lib.Movement) -> None:
+def _plot_attitude(ax, movement) -> None:
     ax.plot(movement.time, movement.head_attitude, color="k")
-    ax.axvspan(0, movement_lib.SETTLE_TIME, color="0.9", label="settling to the start pose")
+    ax.axvspan(0, movement.settle_time, color="0.9", label="settling to the start pose")
     summary = movement.summary()
     ax.set_title(f"(B) head attitude: range {summary['attitude_range_deg']:.1f} deg, "
                  f"head travel {1000 * summary['head_travel_m']:.0f} mm", fontsize=10)
@@ -63,7 +63,7 @@ def _plot_attitude(ax, movement: movement_lib.Movement) -> None:
     ax.legend(fontsize=7, loc="lower right")
 
 
-def _plot_arm(fig, ax, movement: movement_lib.Movement, num_sticks: int) -> None:
+def _plot_arm(fig, ax, movement, num_sticks: int) -> None:
     """Stick figures coloured by time (with a colourbar), the head path and the base joint."""
     import matplotlib.colors as mcolors
     import matplotlib.pyplot as plt
@@ -101,7 +101,7 @@ def _plot_arm(fig, ax, movement: movement_lib.Movement, num_sticks: int) -> None
                  "while the ventral tendons move", fontsize=10)
 
 
-def plot_movement(movement: movement_lib.Movement, path: str | pathlib.Path, num_sticks: int = 12
+def plot_movement(movement, path: str | pathlib.Path, num_sticks: int = 12
                   ) -> pathlib.Path:
     """Write :func:`movement_figure` to ``path`` (PNG)."""
     import matplotlib.pyplot as plt

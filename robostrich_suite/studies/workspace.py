@@ -30,6 +30,7 @@ from robostrich_suite import physics as physics_lib
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite import scenes
+from robostrich_suite.studies import workspace_figure
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
 from robostrich_suite.tasks.lessons import LESSON_TIME_LIMIT
 
@@ -314,7 +315,6 @@ def main(argv=None) -> dict:
                                              progress=not args.no_progress,
                                              seek_level_time=args.seek_level)
     base = base_joint_xz(physics)
-    from robostrich_suite.studies import workspace_figure
     figure = workspace_figure.plot_workspace(kinematic, actuated, base, args.out / "workspace.png")
     samples = save_samples(args.out / "workspace_samples.npz", kinematic, actuated, base)
     level = kinematic.level()

@@ -1,4 +1,5 @@
-"""Fig. 6 of the workspace study (:mod:`robostrich_suite.studies.workspace`).  Plotting only."""
+"""Fig. 6 of the workspace study (:mod:`robostrich_suite.studies.workspace`).  Plotting only: it reads
+the study's samples and imports nothing of the study (the study imports it)."""
 from __future__ import annotations
 
 import pathlib
@@ -6,14 +7,13 @@ import pathlib
 import numpy as np
 
 from robostrich_suite import files
-from robostrich_suite.studies import workspace
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
 
 
-def plot_workspace(kinematic: workspace.KinematicSamples, actuated: workspace.ActuatedSamples | None,
-                   base_xz: np.ndarray, path: str | pathlib.Path) -> pathlib.Path:
+def plot_workspace(kinematic, actuated, base_xz: np.ndarray, path: str | pathlib.Path) -> pathlib.Path:
     """Fig. 6 (red: all head positions, blue: level head, black: base joint) and, on the
-    right, the same kinematic regions faded under the actuated workspace."""
+    right, the same kinematic regions faded under the actuated workspace. ``kinematic``:
+    workspace.KinematicSamples; ``actuated``: workspace.ActuatedSamples or None."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
