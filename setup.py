@@ -31,10 +31,19 @@ setup(
     extras_require={
         # ray: the sweep's tests start a local Ray, and CI installs only this extra
         # optuna: robostrich-design's tests run a search (tests/test_design.py), and CI installs only this extra
-        "test": ["pytest==9.2.0", "pytest-xdist==3.8.0", "gymnasium==1.4.0", "ray==2.60.0", "optuna==5.1.0"],
+        # and the peers' pins (the same as "peers" below; extras here are literal lists, which
+        # tests/test_setup.py reads): tests/test_peers.py runs each peer a few steps through the adapter
+        "test": ["pytest==9.2.0", "pytest-xdist==3.8.0", "gymnasium==1.4.0", "ray==2.60.0", "optuna==5.1.0",
+                 "sbx-rl==0.28.0", "stable-baselines3==2.9.2", "flax==0.12.8", "torch==2.13.0",
+                 "tfp-nightly==0.26.0.dev20261027"],
         "gym": ["gymnasium==1.4.0"],
         "sweep": ["ray==2.60.0"],  # robostrich-sweep: grids of runs as Ray tasks
         "design": ["optuna==5.1.0"],  # robostrich-design: the routing search (its study in SQLite via SQLAlchemy)
+        # tools/benchmark_peers.py: SBX's SAC, TQC and CrossQ beside ours. SBX 0.28 on flax 0.12.8 runs
+        # with jax 0.10.2 and gymnasium 1.4.0; stable-baselines3 needs torch, pinned to 2.13.0, whose CPU
+        # wheel pip takes (unpinned, pip would pull a multi-GB CUDA build); sbx leaves tfp-nightly unpinned.
+        "peers": ["gymnasium==1.4.0", "sbx-rl==0.28.0", "stable-baselines3==2.9.2", "flax==0.12.8", "torch==2.13.0",
+                  "tfp-nightly==0.26.0.dev20261027"],
     },
     entry_points={
         "console_scripts": [

@@ -7,6 +7,7 @@
     python tools/results_page.py add speed_env runs/speed_env.json --title "Environment speed"
     python tools/results_page.py add design out/design/design.json --title "Routings searched"
     python tools/results_page.py add robustness_robostrich out/robustness/robustness.json --title "Robustness"
+    python tools/results_page.py add peers runs/peers/peers.json --title "Peer agents on the arm"
     python tools/results_page.py            # rewrite docs/results.md and every block
     python tools/results_page.py --check    # exit 1 when any of them differs from the records
 
@@ -20,8 +21,8 @@ A record (docs/results/NAME.json) keeps what a benchmark wrote, the command that
 and the machine. Its kind says which benchmark: "seeds" (one group of robostrich-sweep's
 sweep.json, or an earlier tools/benchmark_seeds.py seeds.json; tools/results_seeds.py renders it),
 "dmc" (tools/benchmark_dmc.py's dmc.json), "layouts" (robostrich-layouts' layouts.json),
-"design" (robostrich-design's design.json), "robustness" (robostrich-robustness's robustness.json)
-or "speed" (tools/benchmark_env.py, benchmark_a1.py or benchmark_learner.py with --json). Numbers are
+"design" (robostrich-design's design.json), "robustness" (robostrich-robustness's robustness.json),
+"peers" (tools/benchmark_peers.py's peers.json) or "speed" (tools/benchmark_env.py, benchmark_a1.py or benchmark_learner.py with --json). Numbers are
 typed nowhere else: the page and each block "<!-- results: NAME ... -->" in README.md or a page of
 docs/ are rendered from the records, and tests/test_results_page.py fails when the committed text
 differs from what the records give.
@@ -38,6 +39,7 @@ import sys
 import results_design
 import results_dmc
 import results_layouts
+import results_peers
 import results_robustness
 import results_seeds
 import results_speed
@@ -57,7 +59,7 @@ BLOCK_END = "<!-- /results -->"
 README_RECORD = "main_job"  # the README's first table, which it must have
 
 KINDS = {"seeds": results_seeds, "dmc": results_dmc, "layouts": results_layouts, "speed": results_speed,
-         "design": results_design, "robustness": results_robustness}
+         "design": results_design, "robustness": results_robustness, "peers": results_peers}
 STALE, BAD_INPUT = 1, 2  # exit statuses besides 0 (module doc)
 # A record's fields and their types; "note" and "order" may be left out.
 RECORD_FIELDS = {"format": int, "name": str, "title": str, "kind": str, "command": str, "date": str,
@@ -243,7 +245,7 @@ def build_parser() -> argparse.ArgumentParser:
     add.add_argument("name", help="the record's name (docs/results/NAME.json; a block names it)")
     add.add_argument("written", help="OUT/sweep.json of robostrich-sweep (or an earlier seeds.json), dmc.json of "
                      "tools/benchmark_dmc.py, layouts.json of robostrich-layouts, design.json of robostrich-design, or a "
-                     "speed benchmark's --json file")
+                     "speed benchmark's --json file, or peers.json of tools/benchmark_peers.py")
     add.add_argument("--title", required=True)
     add.add_argument("--group", default=None, help="the sweep's group to record (default: its only one)")
     add.add_argument("--command", dest="run_command", default=None,

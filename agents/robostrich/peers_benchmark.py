@@ -1,0 +1,143 @@
+"""Every agent of the peers' comparison as one list of jobs, run one per core, summed into peers.json.
+
+Why one command: a ratio such as "our curriculum reaches 95 % in X steps, the best peer in Y"
+means something only when both come from the same run on the same machine, budget and seeds.
+Our curriculum SAC and plain SAC are robostrich-train runs (the main job's defaults, at this
+budget); the lookup is evaluated once; the peers are agents/robostrich/peers.py.
+"""
+import contextlib
+import dataclasses
+import json
+import os
+import shutil
+from typing import Optional
+
+import numpy as np
+
+from agents.curriculum import Lesson
+from agents.robostrich import evaluation, peers
+from agents.robostrich.domains import Domain
+
+DOMAIN = "robostrich"
+OURS = {"curriculum": "curriculum SAC (ours)", "plain": "plain SAC (ours, final lesson only)"}
+KINDS = ("heldout", "heldout_moving", "track")
+FIELDS = ("success_rate", "precise_success_rate", "position_error_median", "attitude_error_median")
+BAR = 0.95  # the held-out success whose first crossing the record compares
+
+
+@dataclasses.dataclass(frozen=True)
+class Settings:
+    """The comparison's budget and evaluation, from the command line."""
+    steps: int
+    seeds: tuple
+    agents: tuple  # "curriculum", "plain" and keys of peers.PEERS
+    ways: tuple  # keys of peers.WAYS
+    out: str
+    eval_every: int
+    num_eval_targets: int
+    final_eval_targets: Optional[int]
+    track_task: Optional[str]
+
+
+def lesson_plan(way: str, steps: int) -> tuple:
+    """The main job's lessons and shares at ``steps`` ('lessons'), or its final lesson alone ('final')."""
+    from agents.robostrich.training import MAIN_JOB_LESSON_SHARES
+    tasks = Domain(DOMAIN).curriculum()
+    if way == "final":
+        return (Lesson(DOMAIN, tasks[-1], steps),)
+    shares = MAIN_JOB_LESSON_SHARES[DOMAIN]
+    parts = [steps * share // sum(shares) for share in shares[:-1]]
+    return tuple(Lesson(DOMAIN, t, s) for t, s in zip(tasks, parts + [steps - sum(parts)]))
+
+
+def eval_points(settings: Settings) -> tuple:
+    return tuple(range(settings.eval_every, settings.steps + 1, settings.eval_every)) + (settings.steps,)
+
+
+def job_labels(settings: Settings) -> list:
+    """Run labels, our SAC first (the longest jobs start first)."""
+    ours = [a for a in OURS if a in settings.agents]
+    return ours + [f"{a}_{w}" for a in peers.PEERS if a in settings.agents for w in settings.ways]
+
+
+def peer_spec(settings: Settings, label: str, seed: int) -> peers.PeerSpec:
+    from agents.robostrich import training
+    agent, way = label.rsplit("_", 1)
+    domain = Domain(DOMAIN)
+    return peers.PeerSpec(agent, way, seed, lesson_plan(way, settings.steps),
+                          training.resolve_task_kwargs({}, domain), training.resolve_layout(None, domain),
+                          domain.heldout_task("lesson3"), settings.track_task, eval_points(settings),
+                          settings.num_eval_targets, settings.final_eval_targets, job_dir(settings, label, seed))
+
+
+def ours_argv(settings: Settings, label: str, seed: int) -> list:
+    """robostrich-train's command line for our run ``label`` at this budget (one process, no baseline)."""
+    plan = lesson_plan("lessons" if label == "curriculum" else "final", settings.steps)
+    argv = ["--plan", ",".join(f"{l.domain}/{l.task}:{l.steps}" for l in plan), "--seed", str(seed),
+            "--no-baseline", "--workers", "1", "--out", job_dir(settings, label, seed), "--no-rerun",
+            "--no-figures", "--quiet", "--eval-every", str(settings.eval_every),
+            "--num-eval-targets", str(settings.num_eval_targets), "--track-task", settings.track_task or ""]
+    if settings.final_eval_targets:
+        argv += ["--final-eval-targets", str(settings.final_eval_targets)]
+    return argv
+
+
+def job_dir(settings: Settings, label: str, seed: int) -> str:
+    return os.path.join(settings.out, "runs", label, f"seed_{seed}")
+
+
+def compact(summary: dict) -> dict:
+    return {field: summary.get(field) for field in FIELDS}
+
+
+def run_ours(settings: Settings, label: str, seed: int) -> dict:
+    """Our run through robostrich-train (its lookup evaluation too); its result as a peer's."""
+    from agents.robostrich import training
+    out = job_dir(settings, label, seed)
+    with open(os.path.join(out, "train.log"), "w") as log, contextlib.redirect_stdout(log):
+        summary = training.main(ours_argv(settings, label, seed))
+    curve = training.read_jsonl(os.path.join(out, "curriculum", "evals.jsonl"))
+    return {"env_steps": summary["env_steps"]["curriculum"],
+            "train_seconds": summary["timings"]["curriculum"]["seconds"],
+            "curve": [{"env_steps": r["env_steps"], "summary": r["summary"]} for r in curve],
+            "final": summary["runs"]["curriculum"], "lookup": summary["runs"].get("lookup")}
+
+
+def run_job(settings: Settings, label: str, seed: int) -> dict:
+    """One run in this process (a fresh worker's): trained afresh, its result written to OUT/.../result.json."""
+    out = job_dir(settings, label, seed)
+    shutil.rmtree(out, ignore_errors=True)  # an unfinished run starts again
+    os.makedirs(out)
+    result = run_ours(settings, label, seed) if label in OURS else peers.train(peer_spec(settings, label, seed))
+    result["final"] = {kind: compact(s) for kind, s in result["final"].items()}
+    result["curve"] = [[r["env_steps"], r["summary"]["success_rate"]] for r in result["curve"]]
+    evaluation.write_json(os.path.join(out, "result.json"), result)
+    return result
+
+
+def read_result(settings: Settings, label: str, seed: int) -> Optional[dict]:
+    path = os.path.join(job_dir(settings, label, seed), "result.json")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        return json.load(f)
+
+
+def run_all(settings: Settings, workers: int, say=print) -> dict:
+    """Every (run, seed) not finished yet, ``workers`` at a time, each in a fresh single-threaded
+    process; {(label, seed): result}."""
+    import concurrent.futures
+    import multiprocessing
+    jobs = [(label, seed) for label in job_labels(settings) for seed in settings.seeds]
+    results = {job: read_result(settings, *job) for job in jobs}
+    todo = [job for job in jobs if results[job] is None]
+    os.environ["XLA_FLAGS"] = ((os.environ.get("XLA_FLAGS") or "") + " --xla_cpu_multi_thread_eigen=false"
+                               " intra_op_parallelism_threads=1").strip()  # read by the workers' JAX
+    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
+                                                max_tasks_per_child=1) as pool:
+        futures = {pool.submit(run_job, settings, *job): job for job in todo}
+        for future in concurrent.futures.as_completed(futures):
+            label, seed = futures[future]
+            results[(label, seed)] = future.result()
+            say(f"{label} seed {seed}: done ({results[(label, seed)]['train_seconds'] / 60:.1f} min)")
+    return results
