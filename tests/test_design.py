@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import robostrich_suite
-from robostrich_suite import scenes
+from robostrich_suite import scenes, targets
 from robostrich_suite.model import arm, layouts
-from robostrich_suite.studies import design, design_space, gap_column, layout_compare
+from robostrich_suite.studies import design, design_space, gap_column, gap_passage, layout_compare
 
 import results_page
 from conftest import console_script
@@ -89,6 +89,28 @@ def test_a_ramp_that_stays_still_is_clear_and_one_through_the_shelf_is_not():
     across = gap_column.Scene(x + 0.1, z - 0.01)  # the near shelf cuts the neck halfway along it
     assert across.touches(held.points, held.radii)[0]
     assert not gap_column.ramp_stays_clear(physics, held, 0, 0, across, to_plane, 2.0)
+
+
+def test_the_way_into_a_column_is_clear_under_an_open_sky_and_blocked_by_a_shelf_across_the_neck():
+    spec, layout = design_space.SPEC, layouts.build("ventral_slips")
+    physics = scenes.frame_physics(spec, layout)
+    base = np.array(physics.named.data.xpos["arm/c18"])[[0, 2]]
+    stored = targets.level_head_poses()["control"][100]  # a level pose, head 0.37 m up
+    held = gap_column.hold_poses(physics, [stored], lambda p: np.asarray(p)[[0, 2]] - base, 2.0)
+    # A shelf 2 m up and far ahead: every pose at rest is under it, every ramp to the level pose is clear.
+    sky = gap_column.Column(gap_column.Scene(5.0, 2.0), (0,), 0.0)
+    open_sky = gap_passage.measure(spec, layout, sky, held, 2.0, samples=40, ramps=2)
+    assert open_sky["under_poses"] >= 10 and open_sky["ramps"] == 2 * len(gap_passage.RAMP_TIMES)
+    assert 2 * open_sky["clear"] >= open_sky["ramps"] and open_sky["highest_in_slot_m"] is None  # slot 5 m ahead
+    # Its neck crosses the task's shelf, 13.3 cm above the base joint, away from the slot: no ramp from
+    # under the shelf ends there clear.
+    points = held.points[0]
+    crossing = points[np.argmin(np.abs(points[:, 1] - gap_column.SHELF_Z)), 0]
+    across = gap_column.Column(gap_column.Scene(crossing + 0.12, gap_column.SHELF_Z), (0,), 0.0)
+    assert across.scene.touches(held.points, held.radii)[0]
+    blocked = gap_passage.measure(spec, layout, across, held, 2.0, samples=150, ramps=2)
+    assert blocked["under_poses"] > 0 and blocked["ramps"] > 0 and blocked["clear"] == 0
+    assert blocked["highest_in_slot_m"] is None or blocked["highest_in_slot_m"] < 0.0  # never up through the slot
 
 
 # --------------------------------------------------------------------------- the search

@@ -38,6 +38,18 @@ def _column(row: dict) -> str:
     return f"{100 * row['gap_column_m']:.1f} cm{where}"
 
 
+def _passage(row: dict) -> str:
+    passage = row.get("passage")
+    if not passage:
+        return "not measured"
+    if not passage["ramps"]:
+        return f"no pose under the shelf ({passage['samples']} drawn)"
+    highest = passage["highest_in_slot_m"]
+    where = ("the head never over the slot" if highest is None else
+             f"the head at most {100 * highest:+.1f} cm from the shelf's top over the slot before a touch")
+    return f"{passage['clear']} of {passage['ramps']} ramps clear; {where}"
+
+
 def short(data: dict) -> list:
     """The front (cheap scores, with the full measures where a routing has them), then every routing
     confirmed, on the front now or not."""
@@ -52,9 +64,10 @@ def short(data: dict) -> list:
                      f"{row['rolling_lever_ratio']:.2f} | " + " | ".join(later) + " |")
     if confirmed:
         lines += ["", "Confirmed (robostrich-layouts' measures, every blue cell; the gap column at the full budget):", "",
-                  "| trial | coverage | distinct level targets | gap column | rolling / lever |", "|---|---|---|---|---|"]
+                  "| trial | coverage | distinct level targets | gap column | rolling / lever | "
+                  "from under the shelf into the column |", "|---|---|---|---|---|---|"]
         lines += [f"| {row['trial']} | {_percent(row['coverage'])} ({row['covered_cells']} of {row['blue_cells']} cells) | "
-                  f"{row['distinct_targets']} | {_column(row)} | {row['rolling_lever_ratio']:.2f} |"
+                  f"{row['distinct_targets']} | {_column(row)} | {row['rolling_lever_ratio']:.2f} | {_passage(row)} |"
                   for row in confirmed.values()]
     return lines
 

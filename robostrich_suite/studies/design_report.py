@@ -125,6 +125,12 @@ def write(study, out: pathlib.Path, command: str, storage_url: str, confirmed: l
     return result
 
 
+def passage_text(passage) -> str:
+    if not passage or not passage["ramps"]:
+        return ""
+    return f", into the column from under the shelf {passage['clear']} of {passage['ramps']} ramps clear"
+
+
 def print_summary(result: dict, out: pathlib.Path) -> None:
     trials = result["trials"]
     rate_text = (f", {trials['trials_per_hour']} trials/hour ({trials['trials_per_core_hour']} per hour of one "
@@ -140,7 +146,8 @@ def print_summary(result: dict, out: pathlib.Path) -> None:
           f"{100 * need:.0f} cm above its shelf)")
     for row in result["confirmed"]:
         print(f"  confirmed trial {row['trial']}: coverage {row['coverage']:.0%}, gap column "
-              f"{100 * row['gap_column_m']:.1f} cm, rolling/lever {row['rolling_lever_ratio']:.2f}")
+              f"{100 * row['gap_column_m']:.1f} cm, rolling/lever {row['rolling_lever_ratio']:.2f}"
+              + passage_text(row.get("passage")))
     for name in ("design.json", "front.png"):
         print(f"wrote {out / name}")
     if result["front"]:

@@ -170,8 +170,11 @@ def confirm(study, count: int, out: pathlib.Path, show_progress: bool = True) ->
     if not count or cli_lib.interrupted():
         return confirmed(study)
     from robostrich_suite.studies import design_confirm
-    done = {row["trial"] for row in confirmed(study)}
+    done = {row["trial"]: row for row in confirmed(study)}
     todo = [t for t in pareto_front(study)[:count] if t.number not in done]
     for row in design_confirm.confirm(todo, out, show_progress):
         study.set_user_attr(f"{CONFIRMED}{row['trial']}", row)
+    for number, row in done.items():  # confirmed before the passage was measured: only that is added
+        if "passage" not in row:
+            study.set_user_attr(f"{CONFIRMED}{number}", {**row, **design_confirm.gap_measures(study.trials[number])})
     return confirmed(study)

@@ -206,23 +206,33 @@ def tallest_column(held: HeldPoses, connected, max_ramps: int = MAX_RAMPS) -> Co
     return best
 
 
-def ramp_stays_clear(physics, held: HeldPoses, a: int, b: int, scene: Scene, to_plane, hold_time: float) -> bool:
-    """From reset hold pose ``a``'s inputs for ``hold_time``, ramp them to ``b``'s over
-    :data:`RAMP_TIME` and hold :data:`RAMP_HOLD`: True when no capsule touched ``scene`` on the
-    way and the head ended within :data:`ARRIVAL` of ``b``'s."""
-    geoms, radii, boxes = arm_geoms(physics), held.radii, scene.boxes()
+def ramp_path(physics, start, end, scene: Scene, to_plane, hold_time: float, ramp_time: float = RAMP_TIME):
+    """From reset hold the inputs ``start`` for ``hold_time``, ramp them to ``end`` over ``ramp_time``
+    and hold :data:`RAMP_HOLD`: (clear, heads), ``heads`` (k, 2) at every control step until the
+    first that touched ``scene`` (clear False) or the end."""
+    geoms, boxes = arm_geoms(physics), scene.boxes()
+    radii = capsule_radii(physics, geoms)
     dt = physics.model.opt.timestep
     physics.reset()
-    physics.data.ctrl[:] = held.control[a]
+    physics.data.ctrl[:] = start
     physics.step(int(round(hold_time / dt)))
-    steps, every = int(round((RAMP_TIME + RAMP_HOLD) / dt)), 4  # 4: the environments' control step
+    steps, every = int(round((ramp_time + RAMP_HOLD) / dt)), 4  # 4: the environments' control step
+    heads = []
     for k in range(0, steps, every):
-        f = min(k * dt / RAMP_TIME, 1.0)
-        physics.data.ctrl[:] = (1 - f) * held.control[a] + f * held.control[b]
+        f = min(k * dt / ramp_time, 1.0)
+        physics.data.ctrl[:] = (1 - f) * np.asarray(start) + f * np.asarray(end)
         physics.step(every)
         if physics.divergence is not None or touching(capsule_points(physics, geoms, to_plane), radii, boxes):
-            return False
-    return bool(np.linalg.norm(to_plane(physics.head_position()) - held.head[b]) <= ARRIVAL)
+            return False, np.array(heads).reshape(-1, 2)
+        heads.append(to_plane(physics.head_position()))
+    return True, np.array(heads).reshape(-1, 2)
+
+
+def ramp_stays_clear(physics, held: HeldPoses, a: int, b: int, scene: Scene, to_plane, hold_time: float) -> bool:
+    """True when :func:`ramp_path` from pose ``a``'s inputs to ``b``'s keeps clear of ``scene`` and
+    ends with the head within :data:`ARRIVAL` of ``b``'s."""
+    clear, heads = ramp_path(physics, held.control[a], held.control[b], scene, to_plane, hold_time)
+    return bool(clear and np.linalg.norm(heads[-1] - held.head[b]) <= ARRIVAL)
 
 
 # --------------------------------------------------------------------------- seeking a column
