@@ -33,6 +33,9 @@ OUT_COMMANDS = {
     "robostrich-stabilize": ([], ""),
     "robostrich-gap": ([], ""),
     "robostrich-export-xml": ([], ""),
+    "robostrich-design": (["--trials", "1"], ""),
+    "robostrich-robustness": (["robostrich"], ""),
+    "robostrich-sweep": ([], ""),
 }
 
 

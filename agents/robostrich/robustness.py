@@ -17,6 +17,7 @@ import os
 from agents.robostrich import evaluation
 from agents.robostrich.domains import Domain, as_domain
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import outputs
 from robostrich_suite import policies
 from robostrich_suite.tasks import perturbations
 
@@ -188,11 +189,8 @@ def build_parser() -> cli_lib.Parser:
 
 def _check_out(out: str) -> None:
     """--out must be a directory we may write (before any work)."""
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise ValueError(f"--out {out} is a file, not a directory")
+    outputs.check_directory(out)
     os.makedirs(out, exist_ok=True)
-    if not os.access(out, os.W_OK):
-        raise ValueError(f"--out {out}: no permission to write there")
 
 
 def main(argv=None) -> dict:

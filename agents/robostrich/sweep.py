@@ -18,7 +18,7 @@ import sys
 from agents.robostrich import directory_lock, sweep_grid, sweep_ray, sweep_table
 from agents.robostrich import training  # robostrich-train's own parser checks every group's flags
 from robostrich_suite import cli as cli_lib
-from robostrich_suite import parsing
+from robostrich_suite import outputs, parsing
 from robostrich_suite.files import write_text
 from robostrich_suite.model import layouts as model_layouts
 
@@ -191,6 +191,7 @@ def main(argv=None) -> dict:
     """Parse, check, run what is missing, write the table; returns sweep.json's content."""
     args, passthrough = build_parser().parse_known_args(argv)
     sweep_ray.check_installed()
+    outputs.check_directory(args.out)
     groups, runs = plan(args, passthrough)
     if args.address is not None:
         sweep_ray.check_reachable(args.address)

@@ -40,6 +40,7 @@ import sys
 import warnings
 
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import outputs
 
 PROG = "robostrich-design"
 RATIO_LIMIT = 0.6  # rolling / lever attitude ratio a routing must not pass (module doc)
@@ -81,6 +82,7 @@ def main(argv=None) -> dict:
     args = build_parser().parse_args(argv)
     from robostrich_suite.studies import design_report, design_study
     starts = [design_study.start_layout(item) for item in args.start_from]  # bad ones fail before any work
+    outputs.check_directory(args.out)
     args.out.mkdir(parents=True, exist_ok=True)
     storage_url = args.storage or f"sqlite:///{(args.out / 'study.db').resolve()}"
     study = design_study.open_study(storage_url, args.study_name, args.pose_budget, args.search_stiffness, args.seed)
