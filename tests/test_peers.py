@@ -81,6 +81,12 @@ def test_the_command_writes_its_record_figure_and_table(tmp_path):
     assert "SBX TQC, final lesson only" in results_page.render_record(record)
     assert bench.read_result(bench.Settings(120, (0,), ("tqc",), ("final",), str(out), 60, 1, 1, None),
                              "tqc_final", 0)["env_steps"] == 120
+    # a stopped command's record: the finished runs, the others named; nothing finished is an error
+    common = ["--steps", "120", "--seeds", "0", "--ways", "final", "--eval-every", "60", "--record-only"]
+    assert benchmark_peers.cli(common + ["--agents", "plain,tqc,sac", "--out", str(out)]) == 0
+    data = json.loads((out / "peers.json").read_text())
+    assert set(data["runs"]) == {"plain", "tqc_final"} and data["unfinished"] == ["SBX SAC, final lesson only"]
+    assert benchmark_peers.cli(common + ["--out", str(tmp_path / "empty")]) == 2
 
 
 HIDE_SBX = """import sys

@@ -10,7 +10,8 @@ either on the final lesson alone ('final') or through the main job's lessons and
 through the lessons, our plain SAC trains the final lesson (robostrich-train at this budget).
 All are scored by agents/robostrich/evaluation.py: held-out success from the fixed start every
 --eval-every steps (the curves), then every held-out target from the fixed and from moving
-starts and `track`. --workers runs at a time, one core each; a finished run is not re-run.
+starts and `track`. --workers runs at a time, one core each; a finished run is not re-run, and
+--record-only writes the record from the runs finished so far.
 Writes OUT/peers.json (a results record's input: tools/results_page.py add), OUT/peers.md and
 OUT/learning_curves.png. Needs the peers extra: pip install -e '.[peers]'.
 
@@ -62,6 +63,9 @@ def build_parser():
     p.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS),
                    default=min(2, os.cpu_count() or 1), help="runs at a time, one process each (default: %(default)s)")
     p.add_argument("--out", default="runs/peers", help="output directory (default: %(default)s)")
+    p.add_argument("--record-only", action="store_true",
+                   help="train nothing: write the record from the runs finished in --out so far (the others are "
+                        "named as unfinished), e.g. after the command was stopped")
     return p
 
 
@@ -91,7 +95,10 @@ def main(argv=None) -> int:
     peers.require()  # before a minute of building: the one line says which extra
     from agents.robostrich import evaluation, peers_benchmark as bench, peers_record
     settings = settings_from(args)
-    results = bench.run_all(settings, args.workers, say=lambda line: print(f"{PROG}: {line}", flush=True))
+    results = bench.run_all(settings, args.workers, say=lambda line: print(f"{PROG}: {line}", flush=True),
+                            train=not args.record_only)
+    if not any(results.values()):
+        raise ValueError(f"--record-only: {args.out} holds no finished run of these settings")
     command = shlex.join(["python", "tools/benchmark_peers.py", *(sys.argv[1:] if argv is None else argv)])
     data = peers_record.record(settings, results, command)
     evaluation.write_json(os.path.join(args.out, "peers.json"), data)

@@ -17,7 +17,9 @@ def read(data: dict, path: str, group: str = None) -> tuple:
 def caption(data: dict) -> str:
     versions = ", ".join(f"{k} {v}" for k, v in data.get("versions", {}).items())
     ways = "; ".join(f"{way}: {plan}" for way, plan in data.get("ways", {}).items())
-    return (f"{data['steps']} control steps per run, mean [min, max] over seeds {', '.join(map(str, data['seeds']))}; "
+    unfinished = f" ({', '.join(data['unfinished'])}: not finished)" if data.get("unfinished") else ""
+    return (f"{data['steps']} control steps per run, mean [min, max] over seeds {', '.join(map(str, data['seeds']))}"
+            f"{unfinished}; "
             f"peers with their published defaults ({versions}); lessons as run ({ways}); steps to "
             f"{data['bar'] * 100:.0f} %: the first evaluation point where the seeds' mean held-out success "
             f"(fixed start, {data['num_eval_targets']} targets) reaches it")

@@ -123,14 +123,16 @@ def read_result(settings: Settings, label: str, seed: int) -> Optional[dict]:
         return json.load(f)
 
 
-def run_all(settings: Settings, workers: int, say=print) -> dict:
+def run_all(settings: Settings, workers: int, say=print, train: bool = True) -> dict:
     """Every (run, seed) not finished yet, ``workers`` at a time, each in a fresh single-threaded
-    process; {(label, seed): result}."""
+    process (none with ``train`` False); {(label, seed): result, None where unfinished}."""
     import concurrent.futures
     import multiprocessing
     jobs = [(label, seed) for label in job_labels(settings) for seed in settings.seeds]
     results = {job: read_result(settings, *job) for job in jobs}
-    todo = [job for job in jobs if results[job] is None]
+    todo = [job for job in jobs if results[job] is None] if train else []
+    if not todo:
+        return results
     os.environ["XLA_FLAGS"] = ((os.environ.get("XLA_FLAGS") or "") + " --xla_cpu_multi_thread_eigen=false"
                                " intra_op_parallelism_threads=1").strip()  # read by the workers' JAX
     with concurrent.futures.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),

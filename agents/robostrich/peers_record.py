@@ -39,7 +39,7 @@ def first_reach(curves: list, bar: float = bench.BAR):
 def aggregate(settings, results: dict) -> dict:
     """{label: the run's record entry}: finals per evaluation, wall-clock and curve, over the seeds."""
     runs = {}
-    for label in bench.job_labels(settings):
+    for label in finished(settings, results):
         rows = [results[(label, seed)] for seed in settings.seeds]
         runs[label] = {
             "name": run_name(label),
@@ -52,6 +52,12 @@ def aggregate(settings, results: dict) -> dict:
             "reach_bar": first_reach([row["curve"] for row in rows]),
         }
     return runs
+
+
+def finished(settings, results: dict) -> list:
+    """The runs every seed of which has finished (a record from a stopped command holds only these)."""
+    return [label for label in bench.job_labels(settings)
+            if all(results.get((label, seed)) for seed in settings.seeds)]
 
 
 def lookup(settings, results: dict) -> dict:
@@ -69,7 +75,9 @@ def record(settings, results: dict, command: str) -> dict:
     return {"benchmark": "peers", "command": command, "steps": settings.steps, "seeds": list(settings.seeds),
             "bar": bench.BAR, "num_eval_targets": settings.num_eval_targets, "versions": peers.versions(),
             "ways": {way: describe_way(way, settings.steps) for way in settings.ways},
-            "runs": aggregate(settings, results), "lookup": lookup(settings, results)}
+            "runs": aggregate(settings, results), "lookup": lookup(settings, results),
+            "unfinished": [run_name(label) for label in bench.job_labels(settings)
+                           if label not in finished(settings, results)]}
 
 
 def describe_way(way: str, steps: int) -> str:
