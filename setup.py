@@ -33,9 +33,14 @@ setup(
         # optuna: robostrich-design's tests run a search (tests/test_design.py), and CI installs only this extra
         # and the peers' pins (the same as "peers" below; extras here are literal lists, which
         # tests/test_setup.py reads): tests/test_peers.py runs each peer a few steps through the adapter
+        # playwright: tests/test_web_viewer.py drives the system's Chromium (never a downloaded one) on --web's page
+        # nbclient, nbformat, ipykernel, rerun-notebook: tests/test_tutorial.py runs docs/tutorial.ipynb top to bottom
         "test": ["pytest==9.2.0", "pytest-xdist==3.8.0", "gymnasium==1.4.0", "ray==2.60.0", "optuna==5.1.0",
                  "sbx-rl==0.28.0", "stable-baselines3==2.9.2", "flax==0.12.8", "torch==2.13.0",
-                 "tfp-nightly==0.26.0.dev20261027"],
+                 "tfp-nightly==0.26.0.dev20261027",
+                 "playwright==1.65.3", "nbclient==0.11.0", "nbformat==5.11.1", "ipykernel==7.4.0",
+                 "rerun-notebook==0.41.0"],
+        "notebook": ["ipykernel==7.4.0", "rerun-notebook==0.41.0"],  # docs/tutorial.ipynb, its recording inline
         "gym": ["gymnasium==1.4.0"],
         "sweep": ["ray==2.60.0"],  # robostrich-sweep: grids of runs as Ray tasks
         "design": ["optuna==5.1.0"],  # robostrich-design: the routing search (its study in SQLite via SQLAlchemy)

@@ -39,12 +39,20 @@ class RecordingFile:
     ``discard()`` drops it (``path`` keeps what it held). Rerun's own file sink writes from a
     thread of its own and only logs a failed write; its stream read once, at the end, is the whole
     .rrd (one read per chunk would make a file of many streams, which Rerun calls corrupt). Memory:
-    the recording's size, a few MB for a minute of the arm."""
+    the recording's size, a few MB for a minute of the arm. ``blueprint`` (robostrich_suite.rerun_blueprint)
+    goes into the file, so that a viewer opens it in that layout; ``send_blueprint`` can add it later."""
 
-    def __init__(self, app_id: str, path: str | pathlib.Path, recording_id: str | None = None):
+    def __init__(self, app_id: str, path: str | pathlib.Path, recording_id: str | None = None,
+                 blueprint=None):
         self.path = pathlib.Path(path)
         self.stream = rr.RecordingStream(app_id, recording_id=recording_id)
         self.encoded = self.stream.binary_stream()
+        if blueprint is not None:
+            self.send_blueprint(blueprint)
+
+    def send_blueprint(self, blueprint) -> None:
+        """Make ``blueprint`` the recording's active and default layout."""
+        self.stream.send_blueprint(blueprint, make_active=True, make_default=True)
 
     def close(self) -> pathlib.Path:
         data = self.encoded.read(flush=True) or b""
@@ -59,10 +67,10 @@ class RecordingFile:
 
 
 @contextlib.contextmanager
-def recording(app_id: str, path: str | pathlib.Path, recording_id: str | None = None):
-    """A recording stream for the block, written to ``path`` (an ``.rrd`` file) when the block
-    ends without an error, and to no file otherwise (``RecordingFile``)."""
-    file = RecordingFile(app_id, path, recording_id)
+def recording(app_id: str, path: str | pathlib.Path, recording_id: str | None = None, blueprint=None):
+    """A recording stream for the block, written to ``path`` (an ``.rrd`` file) with ``blueprint``
+    when the block ends without an error, and to no file otherwise (``RecordingFile``)."""
+    file = RecordingFile(app_id, path, recording_id, blueprint)
     try:
         yield file.stream
     except BaseException:
@@ -107,7 +115,7 @@ def log_geometry(rec: rr.RecordingStream, physics, root: str = "world",
         size = model.geom_size[geom_id]
         pos = model.geom_pos[geom_id]
         quat = model.geom_quat[geom_id]
-        geom_type = model.geom_type[geom_id]
+        geom_type = int(model.geom_type[geom_id])  # a numpy int is never `in` a tuple of mjtGeom members
         color = [_rgba(rgba)]
         if geom_type in (types.mjGEOM_CAPSULE, types.mjGEOM_CYLINDER):
             rotation = np.zeros(9)

@@ -1,7 +1,8 @@
 """Shared test set-up: headless MuJoCo (MUJOCO_GL=egl unless the environment sets it), the
 checked-in models, one way to find an installed console script (``from conftest import
 console_script``), one way to run it as a user would (``start`` / ``finish``, sharing one XLA
-cache per module with the ``shared_jax_cache`` fixture) and one way to check Rerun recordings.
+cache per module with the ``shared_jax_cache`` fixture) and ways to check Rerun recordings (``verify_rrd``,
+``rrd_entities``, ``rrd_view_names``).
 The scripts of ``tools/`` import as modules (``import results_page``)."""
 import os
 import pathlib
@@ -79,3 +80,25 @@ def start(name, *args, cwd=None) -> subprocess.Popen:
 def finish(process, timeout=600) -> subprocess.CompletedProcess:
     stdout, stderr = process.communicate(timeout=timeout)
     return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
+
+
+def rrd_entities(path) -> set:
+    """The entity paths of the first recording in the .rrd file ``path`` (read by rerun-sdk's reader)."""
+    import rerun as rr
+    return set(rr.chunk.RrdReader(str(path)).stream().collect().schema().entity_paths())
+
+
+def rrd_view_names(path) -> list:
+    """The names of the views in the first blueprint of the .rrd (or .rbl) file ``path``, in no set
+    order; [] if it carries no blueprint."""
+    import rerun as rr
+    reader = rr.chunk.RrdReader(str(path))
+    if not reader.blueprints():
+        return []
+    names = []
+    for chunk in reader.stream(store=reader.blueprints()[0]).to_chunks():
+        batch = chunk.to_record_batch()
+        for column in batch.schema.names:
+            if column.endswith("ViewBlueprint:display_name"):
+                names += [name for row in batch.column(column).to_pylist() for name in row]
+    return names

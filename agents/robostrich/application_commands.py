@@ -4,7 +4,8 @@ Sec. 5.2 for a trained checkpoint beside zero tendon input and the lookup.
 Each writes into `--out` a JSON report (`*_report.json`: per policy the summary over seeds
 and every seed's numbers), the seed-0 series (`*_series.json`), a short text table
 (`*_summary.txt`, also printed), a figure (`*.png`, Fig. 9 / Fig. 12) and a Rerun recording
-of each policy's seed-0 rollout (`*_LABEL.rrd`).  Without a checkpoint only the two
+of each policy's seed-0 rollout (`*_LABEL.rrd`), which `--web` then serves in the browser until
+Ctrl-C (robostrich_suite/web_viewer.py).  Without a checkpoint only the two
 references run (what a trained policy has to beat).  Errors exit 2 with one line
 (robostrich_suite.cli).
 """
@@ -35,13 +36,16 @@ def _parser(description: str, out: str) -> argparse.ArgumentParser:
     parser.add_argument("--no-rerun", action="store_true", help="no .rrd recordings")
     parser.add_argument("--no-figures", action="store_true", help="no PNG figure")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    from robostrich_suite import web_viewer
+    web_viewer.add_flags(parser)
     return parser
 
 
 def _setup(args):
     """Gait, policies and output directory, every input checked before any rollout."""
-    from robostrich_suite import outputs
+    from robostrich_suite import outputs, web_viewer
     outputs.check_directory(args.out)
+    web_viewer.check(args)
     gait = applications.load_gait(args.gait)
     policies = applications.policies(args.checkpoint, args.reference, args.layout)
     os.makedirs(args.out, exist_ok=True)
@@ -79,14 +83,17 @@ def _report(args, name: str, meta: dict, results: dict, series: dict, table: str
             plot) -> dict:
     """Write NAME's report, series and table into ``args.out``, the figure (``plot(series as
     arrays, path)``) unless --no-figures, print the table and every file written (the
-    evaluation already wrote each policy's NAME_LABEL.rrd unless --no-rerun)."""
+    evaluation already wrote each policy's NAME_LABEL.rrd unless --no-rerun), then with --web
+    serve those recordings until Ctrl-C."""
     written = _write(args.out, name, {**meta, "policies": results}, series, table)
     if not args.no_figures:
         written.append(os.path.join(args.out, f"{name}.png"))
         plot({k: {"series": {n: np.asarray(v) for n, v in s.items()}} for k, s in series.items()}, written[-1])
-    if not args.no_rerun:
-        written += [os.path.join(args.out, f"{name}_{p.label}.rrd") for p in policies]
-    print(table + "wrote " + ", ".join(written))
+    recordings = [] if args.no_rerun else [os.path.join(args.out, f"{name}_{p.label}.rrd") for p in policies]
+    print(table + "wrote " + ", ".join(written + recordings), flush=True)
+    if args.web:
+        from robostrich_suite import web_viewer
+        web_viewer.serve(recordings, args.web_port)
     return {"meta": meta, "policies": results}
 
 

@@ -6,7 +6,8 @@ the no-learning `lookup` baseline (agents/robostrich/lookup.py) is evaluated bes
 agents.  Other dm_control domains report episode returns.  Writes one JSON
 report per evaluation. `main` (console command
 `robostrich-evaluate`) loads a checkpoint and writes the same reports,
-figures and Rerun recordings as the end of a training run.
+figures and Rerun recordings as the end of a training run; with `--web` it then serves the
+recordings in the browser until Ctrl-C (robostrich_suite/web_viewer.py).
 """
 import argparse
 import json
@@ -17,7 +18,7 @@ from typing import Optional
 
 import numpy as np
 
-from robostrich_suite import files, outputs
+from robostrich_suite import files, outputs, web_viewer
 from agents.robostrich import probes
 from agents.robostrich.runs import make_environment
 from agents.robostrich.domains import MOVING_START_TASK, TRACK_TASK, as_domain
@@ -354,12 +355,16 @@ def main(argv=None):
                         help=f"held-out targets (default: all; at most {MAX_TARGETS})")
     parser.add_argument("--no-rerun", action="store_true", help="no .rrd recordings")
     parser.add_argument("--no-figures", action="store_true", help="no PNG figures")
+    web_viewer.add_flags(parser)
     args = parser.parse_args(argv)
     out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.checkpoint)), "evaluation")
     outputs.check_directory(out)
+    web_viewer.check(args)
     fingerprint = checked_fingerprint(args.checkpoint)  # every input checked before the run is rebuilt
     domain = checkpoint_domain(fingerprint)
     track_task = check_track_task(domain, args.track_task)
+    if args.web and not track_task:
+        raise ValueError("--web serves the track task's recordings, and this evaluation runs no track task")
     from agents.robostrich.runs import parse_plan
     heldout_task = check_heldout_task(domain, args.heldout_task
                                       or default_heldout_task(domain, parse_plan(fingerprint["plan"])[-1].task))
@@ -379,7 +384,10 @@ def main(argv=None):
                            os.path.join(out, f"{args.label}_track.png"))
     summary = {label: {kind: r["summary"] for kind, r in rs.items()} for label, rs in reports.items()}
     write_json(os.path.join(out, "summary.json"), summary)
-    print(json.dumps(summary, indent=1))
+    print(json.dumps(summary, indent=1), flush=True)
+    if args.web:
+        recordings = [os.path.join(out, f"{label}_track.rrd") for label in reports]
+        web_viewer.serve([path for path in recordings if os.path.exists(path)], args.web_port)
     return reports
 
 

@@ -4,7 +4,8 @@ Runs a policy file (robostrich_suite.policies; default: the default robot's curr
 policy) on the held-out targets from the fixed start, then on the frame's `track` task or, for a
 policy of the arm on the quadruped, on `head_stabilize` (Fig. 9, one gait phase); prints its
 success, and writes the reports, a Rerun recording of the second task and its figure. Each line
-is printed as its part ends (flushed: a pipe, `| tee`, sees it then).
+is printed as its part ends (flushed: a pipe, `| tee`, sees it then). With `--web` it then serves
+the recording in the browser until Ctrl-C (robostrich_suite/web_viewer.py).
 """
 import os
 
@@ -12,7 +13,7 @@ from agents.robostrich import evaluation, figures
 from agents.robostrich.domains import TRACK_TASK, as_domain
 from agents.robostrich.recording import open_recorder
 from robostrich_suite import cli as cli_lib
-from robostrich_suite import outputs, policies
+from robostrich_suite import outputs, policies, web_viewer
 
 LABEL = "policy"
 
@@ -64,8 +65,10 @@ def main(argv=None) -> dict:
     parser.add_argument("--num-targets", type=evaluation.target_count, default=None,
                         help="held-out targets to try (default: all)")
     parser.add_argument("--no-rerun", action="store_true", help="write no .rrd recording")
+    web_viewer.add_flags(parser)
     args = parser.parse_args(argv)
     outputs.check_directory(args.out)
+    web_viewer.check(args)
     policy = policies.load_policy(args.policy)
     domain = as_domain(policy.info.get("domain", "robostrich"), policy.info.get("layout"))
     heldout_task = evaluation.default_heldout_task(domain, TRACK_TASK)
@@ -83,6 +86,8 @@ def main(argv=None) -> dict:
         report.update(label=LABEL, policy=args.policy)
         evaluation.write_json(os.path.join(args.out, f"{LABEL}_{kind}.json"), report)
     print(f"wrote {args.out}/: reports, {', '.join(written)}", flush=True)
+    if args.web:
+        web_viewer.serve([os.path.join(args.out, name) for name in written if name.endswith(".rrd")], args.web_port)
     return reports
 
 

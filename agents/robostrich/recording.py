@@ -41,10 +41,11 @@ class RolloutRecorder:
         self._geometry_logged = False
 
     def _log_arm(self, env):
-        """Arm shapes via robostrich_suite.rerun_log (geometry once, body poses per step)."""
-        from robostrich_suite import rerun_log
+        """Arm shapes via robostrich_suite.rerun_log (geometry and the layout once, body poses per step)."""
+        from robostrich_suite import rerun_blueprint, rerun_log
         if not self._geometry_logged:
             self._geometry_logged = True
+            self.file.send_blueprint(rerun_blueprint.rollout(side_view=not hasattr(env.physics, "from_trunk_frame")))
             rerun_log.log_geometry(self.rec, env.physics)
         rerun_log.log_body_poses(self.rec, env.physics)
 
@@ -106,12 +107,16 @@ def open_recorder(path: Optional[str], name: str):
 
 CURVE_FIELDS = ("return", "success", "position_error", "attitude_error", "critic_loss", "actor_loss",
                 "alpha_loss", "temperature", "entropy")
+EVAL_FIELDS = ("success_rate", "position_error_median", "attitude_error_median", "return_mean")
 
 
 def log_training_curves(path: str, runs: Dict[str, List[dict]], evals: Dict[str, List[dict]] = None):
     """Training curves of each run on an `env_steps` timeline (one .rrd, one entity per run and field)."""
-    from robostrich_suite import rerun_log
-    with rerun_log.recording("robostrich", path, recording_id="training") as rec:
+    from robostrich_suite import rerun_blueprint, rerun_log
+    groups = [(field.replace("_", " "), f"training/{field}") for field in CURVE_FIELDS]
+    groups += [(f"held-out {field.replace('_', ' ')}", f"heldout/{field}") for field in EVAL_FIELDS]
+    with rerun_log.recording("robostrich", path, recording_id="training",
+                             blueprint=rerun_blueprint.curves(groups)) as rec:
         _log_curves(rec, runs, evals or {})
 
 
@@ -130,7 +135,7 @@ def _log_curves(rec, runs: Dict[str, List[dict]], evals: Dict[str, List[dict]]):
         if not records:
             continue
         steps = np.array([r["env_steps"] for r in records], np.int64)
-        for field in ("success_rate", "position_error_median", "attitude_error_median", "return_mean"):
+        for field in EVAL_FIELDS:
             if field not in records[0]["summary"]:  # no errors on e.g. reacher; returns only
                 continue
             values = np.array([r["summary"][field] for r in records], np.float64)

@@ -32,6 +32,9 @@ SETTLE_TIME = 3.0  # s before the ventral ramps start: the start pose comes to r
 RAMP_IN_TIME = 1.0  # s over which the start inputs are ramped in from the straight neck
 HOLD_TIME = 1.5  # s after the last ramp, to see the end pose at rest
 DORSAL_HOLD_GAIN = 30.0  # 1/s, integral gain of the dorsal length hold
+# What PATTERN.rrd opens on, beside the arm (robostrich_suite.rerun_blueprint).
+MOVEMENT_SERIES = (("Tendon inputs", ["tendon_input/**"]), ("Tendon contraction", ["tendon_contraction/**"]),
+                   ("Head attitude (deg)", ["head/attitude_deg"]))
 RECORD_EVERY = int(round(CONTROL_TIMESTEP / PHYSICS_TIMESTEP))  # physics steps per frame: a control step
 
 
@@ -460,7 +463,9 @@ def run_patterns(args, base: MovementConfig, spec) -> tuple[dict, list]:
             movement = run(config, spec, progress=progress)
         else:
             from robostrich_suite import rerun_log
-            with rerun_log.recording(f"robostrich_movement_{pattern}", rrd) as recording:
+            from robostrich_suite import rerun_blueprint
+            layout = rerun_blueprint.robot_and_series(MOVEMENT_SERIES, rerun_blueprint.SIDE_EYE)
+            with rerun_log.recording(f"robostrich_movement_{pattern}", rrd, blueprint=layout) as recording:
                 movement = run(config, spec, recording=recording, progress=progress)
             written.append(rrd)
         written.append(movement_figure.plot_movement(movement, args.out / f"{pattern}.png"))

@@ -21,9 +21,20 @@ from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs
 from robostrich_suite import progress as progress_lib
 from robostrich_suite import physics as physics_lib
-from robostrich_suite import rerun_log
+from robostrich_suite import rerun_blueprint, rerun_log
 from robostrich_suite.robostrich_a1 import CONTROL_TIMESTEP, SUITE
 from robostrich_suite.tasks import gait as gait_lib
+
+
+# What walk.rrd opens on: the robot beside the series a reader of Fig. 9 compares (plots/ holds more).
+WALK_SERIES = (("Heights (m)", ["plots/trunk_height", "plots/height_command", "plots/head_height"]),
+               ("Speeds (m/s)", ["plots/trunk_speed", "plots/head_speed", "plots/head_vertical_speed"]),
+               ("Head attitude, trunk pitch (deg)", ["plots/head_attitude", "plots/trunk_pitch"]))
+
+
+def walk_blueprint():
+    """The layout walk.rrd opens in: the quadruped (camera left to Rerun) beside WALK_SERIES."""
+    return rerun_blueprint.robot_and_series(WALK_SERIES, robot="Quadruped, arm and head path")
 
 
 def scripted_tendons(kind: str, control_range: np.ndarray, dorsal: int):
@@ -65,7 +76,7 @@ def record_walk(task_name: str = "head_stabilize", seconds: float = 10.0, tendon
     steps = int(round(seconds / CONTROL_TIMESTEP))
     if rrd_path is None:
         return _walk(env, script, steps, None, progress)
-    with rerun_log.recording("robostrich_a1_walk", pathlib.Path(rrd_path)) as rec:
+    with rerun_log.recording("robostrich_a1_walk", pathlib.Path(rrd_path), blueprint=walk_blueprint()) as rec:
         rerun_log.log_geometry(rec, physics)
         return _walk(env, script, steps, rec, progress)
 
