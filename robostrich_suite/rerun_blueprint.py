@@ -13,7 +13,7 @@ import rerun.blueprint as rrb
 
 # The frame arm seen from the side, as the scene's `side` camera sees it (robostrich_suite/scenes.py):
 # it moves in the x-z plane, so the eye looks along +y at the middle of its workspace.
-SIDE_EYE = rrb.EyeControls3D(position=[0.25, -1.5, 0.4], look_target=[0.25, 0.0, 0.35], eye_up=[0.0, 0.0, 1.0])
+SIDE_EYE = rrb.EyeControls3D(position=[0.2, -1.4, 0.5], look_target=[0.2, 0.0, 0.35], eye_up=[0.0, 0.0, 1.0])
 
 # What a rollout's plots hold (agents/robostrich/recording.py): (view title, entities).
 ROLLOUT_SERIES = (

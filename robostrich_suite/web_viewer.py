@@ -2,9 +2,10 @@
 
 Once the command has written its ``.rrd`` files, rerun-sdk's own ``rerun`` program serves them on
 127.0.0.1 only (the SDK's in-process servers listen on every interface): the viewer's page on
-``--web-port`` and, beside it, a gRPC server holding the recordings on a free port it is handed.
-No display and no native viewer are needed; any browser on this machine (or one reaching it by an
-SSH tunnel) opens the printed URL, in the layout the files carry (robostrich_suite.rerun_blueprint).
+``--web-port`` and the gRPC server that holds the recordings on the port after it. No display and
+no native viewer are needed; a browser on this machine, or on another through an SSH tunnel of both
+ports (``ssh -L 9090:127.0.0.1:9090 -L 9091:127.0.0.1:9091 HOST``), opens the printed URL, in the
+layout the files carry (robostrich_suite.rerun_blueprint).
 The command then waits: Ctrl-C stops the servers (exit 130, robostrich_suite/cli.py).
 
     add_flags(parser); ...; check(args)   # before any work: a busy port is one line, exit 2
@@ -33,9 +34,9 @@ def add_flags(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--web", action="store_true",
                         help=f"then serve the .rrd recordings in Rerun's web viewer at http://{HOST}:PORT "
                              "until Ctrl-C (no display or native viewer needed)")
-    parser.add_argument("--web-port", type=cli_lib.whole_number(1, 65535), default=DEFAULT_PORT, metavar="PORT",
-                        help=f"port of the web viewer's page with --web (default {DEFAULT_PORT}); its gRPC "
-                             "server takes a free port")
+    parser.add_argument("--web-port", type=cli_lib.whole_number(1, 65534), default=DEFAULT_PORT, metavar="PORT",
+                        help=f"port of the web viewer's page with --web (default {DEFAULT_PORT}); the recordings' "
+                             "gRPC server takes PORT+1")
 
 
 def check(args: argparse.Namespace) -> None:
@@ -46,7 +47,7 @@ def check(args: argparse.Namespace) -> None:
     if getattr(args, "no_rerun", False):
         raise ValueError("--web serves the .rrd recordings, which --no-rerun turns off: drop one of them")
     rerun_program()
-    check_port(args.web_port)
+    check_ports(args.web_port)
 
 
 def rerun_program() -> str:
@@ -64,22 +65,17 @@ def rerun_program() -> str:
     return found
 
 
-def check_port(port: int) -> None:
-    """ValueError naming --web-port if something listens on HOST:port (bound as the server will bind it)."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            probe.bind((HOST, port))
-        except OSError as error:
-            raise ValueError(f"--web-port {port}: {HOST}:{port} is taken ({error.strerror}); "
-                             "choose another port with --web-port") from None
-
-
-def free_port() -> int:
-    """A port nothing listens on now (the OS's pick), for the gRPC server."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind((HOST, 0))
-        return probe.getsockname()[1]
+def check_ports(web_port: int) -> None:
+    """ValueError naming --web-port if something listens on HOST:web_port or on the gRPC port after it
+    (each bound as the server will bind it)."""
+    for port, what in ((web_port, ""), (web_port + 1, " (PORT+1, the recordings' gRPC server)")):
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+            probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            try:
+                probe.bind((HOST, port))
+            except OSError as error:
+                raise ValueError(f"--web-port {web_port}: {HOST}:{port}{what} is taken ({error.strerror}); "
+                                 "choose another port with --web-port") from None
 
 
 def viewer_url(web_port: int, grpc_port: int) -> str:
@@ -116,8 +112,8 @@ def serve(paths, web_port: int, out=sys.stdout) -> None:
     paths = [str(p) for p in paths]
     if not paths:
         raise ValueError("--web has no recording to serve")
-    check_port(web_port)  # again: the command's work took a while
-    grpc_port = free_port()
+    check_ports(web_port)  # again: the command's work took a while
+    grpc_port = web_port + 1
     command = [rerun_program(), "--serve-web", "--bind", HOST, "--web-viewer-port", str(web_port),
                "--port", str(grpc_port), *paths]
     with tempfile.TemporaryFile() as log:

@@ -39,10 +39,17 @@ SAVED = """() => {
 }"""
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
+def _free_ports() -> int:
+    """A port P with P and P+1 free now (--web serves the page on P, the recordings' gRPC on P+1)."""
+    while True:
+        with socket.socket() as page, socket.socket() as grpc:
+            page.bind(("127.0.0.1", 0))
+            port = page.getsockname()[1]
+            try:
+                grpc.bind(("127.0.0.1", port + 1))
+            except (OSError, OverflowError):
+                continue
+            return port
 
 
 def _play(*args) -> subprocess.Popen:
@@ -94,11 +101,11 @@ def _loaded(page, tmp_path, timeout: float = 240) -> tuple:
 
 def test_play_web_serves_the_recording_to_a_real_browser_and_stops_on_ctrl_c(tmp_path):
     playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright is in the test extra")
-    port = _free_port()
+    port = _free_ports()
     play = _play("--web", "--web-port", port, "--num-targets", 1, "--out", tmp_path / "play")
     try:
         url = _served_url(play)
-        assert url.startswith(f"http://127.0.0.1:{port}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A"), url
+        assert url == f"http://127.0.0.1:{port}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A{port + 1}%2Fproxy", url
         with playwright_api.sync_playwright() as playwright:
             browser = _browser(playwright)
             page = browser.new_page(viewport={"width": 1400, "height": 900})
@@ -117,19 +124,27 @@ def test_play_web_serves_the_recording_to_a_real_browser_and_stops_on_ctrl_c(tmp
         _end(play)
 
 
-def test_a_taken_port_is_one_line_and_exit_2_before_any_work(tmp_path):
+@pytest.mark.parametrize("taken_offset, what", [(0, ""), (1, " (PORT+1, the recordings' gRPC server)")],
+                         ids=["page", "grpc"])
+def test_a_taken_port_is_one_line_and_exit_2_before_any_work(tmp_path, taken_offset, what):
+    port = _free_ports()
     with socket.socket() as taken:
-        taken.bind(("127.0.0.1", 0))
+        taken.bind(("127.0.0.1", port + taken_offset))
         taken.listen()
-        port = taken.getsockname()[1]
         play = _play("--web", "--web-port", port, "--out", tmp_path / "play")
         try:
             stdout, stderr = play.communicate(timeout=300)
         finally:
             _end(play)
     assert play.returncode == 2, stderr[-3000:]
-    assert stderr.splitlines() == [f"robostrich-play: error: --web-port {port}: 127.0.0.1:{port} is taken "
-                                   "(Address already in use); choose another port with --web-port"], stderr
+    assert stderr.splitlines() == [f"robostrich-play: error: --web-port {port}: 127.0.0.1:{port + taken_offset}{what} "
+                                   "is taken (Address already in use); choose another port with --web-port"], stderr
     assert stdout == "" and not (tmp_path / "play").exists()
+
+
+def test_web_with_no_recording_is_refused(tmp_path):
     refused = _play("--web", "--no-rerun", "--out", tmp_path / "play")
-    assert refused.wait(300) == 2 and "--no-rerun" in refused.stderr.read()
+    stdout, stderr = refused.communicate(timeout=300)
+    assert refused.returncode == 2 and stdout == "", stderr[-3000:]
+    assert stderr.splitlines() == ["robostrich-play: error: --web serves the .rrd recordings, which --no-rerun "
+                                   "turns off: drop one of them"], stderr
