@@ -64,7 +64,22 @@ def test_train_exits_zero_and_writes_its_run(trained):
     assert_succeeded(result)
     for name in ("config.json", "summary.json", "curriculum/checkpoint.ckpt", "evaluation/curriculum_heldout.json"):
         assert (out / name).stat().st_size > 0, name
-    assert '"curriculum"' in result.stdout  # the summary goes to stdout, not a dump to stderr
+    lines = result.stdout.strip().splitlines()  # a few lines a person reads; the JSON stays in the files
+    assert lines[0].startswith("curriculum ") and "% reached (" in lines[0] and "within 1 cm and 2 deg" in lines[0]
+    assert any(line.startswith("lookup ") for line in lines) and "{" not in result.stdout
+    assert lines[-1].startswith(f"wrote {out}/: summary.json") and len(lines) <= 8, result.stdout
+    assert not (out / ".lock").exists()  # a clean end leaves only the results
+
+
+def test_resuming_a_finished_run_shows_its_results_again(trained):
+    _, out = trained
+    before = {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()}
+    result = call("robostrich-train", *TINY_TRAIN, "--out", out, "--resume")
+    assert_succeeded(result)
+    lines = result.stdout.strip().splitlines()
+    assert lines[0] == f"{out} is finished; nothing to resume" and lines[1].startswith("curriculum "), result.stdout
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()} == before  # nothing evaluated again
+    assert "step/s" not in result.stderr, result.stderr
 
 
 def test_evaluate_exits_zero_on_a_checkpoint(trained, tmp_path):
@@ -73,6 +88,11 @@ def test_evaluate_exits_zero_on_a_checkpoint(trained, tmp_path):
                   "--num-targets", "1", "--no-rerun", "--no-figures")
     assert_succeeded(result)
     assert (tmp_path / "ev" / "summary.json").stat().st_size > 0
+    lines = result.stdout.strip().splitlines()
+    firsts = ["eval", "heldout_moving", "track", "lookup", "heldout_moving", "track"]  # label, then its kinds
+    assert [line.split()[0] for line in lines[:-1]] == firsts and lines[0].split()[1] == "heldout", result.stdout
+    assert lines[-1] == f"wrote {tmp_path / 'ev'}/: summary.json, reports", result.stdout
+    assert "1/" in result.stderr and "episode" in result.stderr  # the evaluation's progress bar
 
 
 def test_train_runs_on_the_quadruped_and_on_another_layout(tmp_path):

@@ -23,6 +23,7 @@ from agents.robostrich import probes
 from agents.robostrich.runs import make_environment
 from agents.robostrich.domains import MOVING_START_TASK, TRACK_TASK, as_domain
 from robostrich_suite import cli as cli_lib
+from robostrich_suite import progress as progress_lib
 from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, PRECISE_POSITION_TOLERANCE
 
 MAX_TARGETS = 10_000  # held-out targets (or seeded episodes off the arm) of one evaluation
@@ -163,7 +164,7 @@ def _names(domain) -> dict:
 
 
 def evaluate_heldout(actor, flattener, domain, task: str, num_targets: Optional[int] = None,
-                     seed: int = 10_000, targets=None, action_repeat: int = 1) -> dict:
+                     seed: int = 10_000, targets=None, action_repeat: int = 1, on_episode=None) -> dict:
     """Deterministic policy, one episode per held-out target (a pool of that single target).
 
     Use a task with a fixed initial state (lesson2): every target then starts from the same pose.
@@ -184,6 +185,8 @@ def evaluate_heldout(actor, flattener, domain, task: str, num_targets: Optional[
         if targets is not None:
             row["target"] = targets[i].tolist()
         episodes.append(row)
+        if on_episode:
+            on_episode()
     return {"kind": "heldout", **_names(domain), "task": task, "summary": summarize(episodes), "episodes": episodes}
 
 
@@ -194,7 +197,8 @@ def moving_starts(count: int = 3, domain="robostrich"):
 
 
 def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: Optional[int] = None,
-                            seed: int = 30_000, targets=None, starts=None, action_repeat: int = 1) -> dict:
+                            seed: int = 30_000, targets=None, starts=None, action_repeat: int = 1,
+                            on_episode=None) -> dict:
     """Every held-out target from poses where the arm holds another target (lesson 3's situation).
 
     One lesson-3 environment: per (start, target), an episode from the fixed
@@ -220,6 +224,8 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
             row.update(target=np.asarray(target).tolist(), start=k, start_target=np.asarray(start).tolist(),
                        start_position_error=start_error[0], start_attitude_error=start_error[1])
             episodes.append(row)
+            if on_episode:
+                on_episode()
     return {"kind": "heldout_moving", **_names(domain), "task": MOVING_START_TASK, "summary": summarize(episodes),
             "episodes": episodes}
 
@@ -242,25 +248,57 @@ def evaluate_track(actor, flattener, domain="robostrich", task: str = "track", s
 
 def evaluate_agent(actor, flattener, out_dir: str, label: str, domain, heldout_task: str,
                    track_task: Optional[str], num_targets: Optional[int] = None, env_steps: int = None,
-                   record: bool = True, action_repeat: int = 1) -> dict:
+                   record: bool = True, action_repeat: int = 1, on_episode=None) -> dict:
     """Held-out (+ from moving starts on the arm) + track evaluation, JSON reports and (optionally) a Rerun
-    recording of the track rollout."""
+    recording of the track rollout. ``on_episode()`` is called after each of its `episode_count` episodes."""
     os.makedirs(out_dir, exist_ok=True)
     reports = {"heldout": evaluate_heldout(actor, flattener, domain, heldout_task, num_targets,
-                                           action_repeat=action_repeat)}
+                                           action_repeat=action_repeat, on_episode=on_episode)}
     if as_domain(domain).has_moving_starts:
         reports["heldout_moving"] = evaluate_heldout_moving(actor, flattener, domain, num_targets,
-                                                            action_repeat=action_repeat)
+                                                            action_repeat=action_repeat, on_episode=on_episode)
     if track_task:
         from agents.robostrich.recording import open_recorder
         with open_recorder(os.path.join(out_dir, f"{label}_track.rrd") if record else None,
                            f"{label} track") as recorder:
             reports["track"] = evaluate_track(actor, flattener, domain, track_task, recorder=recorder,
                                               action_repeat=action_repeat)
+        if on_episode:
+            on_episode()
     for kind, report in reports.items():
         report.update(label=label, env_steps=env_steps)
         write_json(os.path.join(out_dir, f"{label}_{kind}.json"), report)
     return reports
+
+
+def episode_count(domain, num_targets: Optional[int], track_task: Optional[str]) -> int:
+    """Episodes of one `evaluate_agent` (for its progress bar): each held-out target from the fixed
+    start and, on the arm, from each moving start; one `track` episode."""
+    domain = as_domain(domain)
+    targets = heldout_targets(domain, num_targets)
+    count = len(targets) if targets is not None else (num_targets or 10)
+    return count * (1 + (len(moving_starts(domain=domain)[0]) if domain.has_moving_starts else 0)) + bool(track_task)
+
+
+def summary_lines(runs: dict) -> list:
+    """What a person reads at the end of an evaluation (the JSON stays in the files): per run and
+    kind, success at the task's tolerances, the share within 1 cm and 2 deg and the median final
+    errors, as robostrich-play prints them; returns only, off the arm. ``runs``: label -> kind -> summary."""
+    lines = []
+    for label, kinds in runs.items():
+        for kind, s in kinds.items():
+            head = f"{label:10s} {kind:14s}"
+            label = ""
+            if "success_rate" not in s:
+                lines.append(f"{head} return {s['return_mean']:.1f} mean [{s['return_min']:.1f}, "
+                             f"{s['return_max']:.1f}], {s['episodes']} episodes")
+                continue
+            lines.append(f"{head} {s['success_rate'] * 100:5.1f} % reached "
+                         f"({s['precise_success_rate'] * 100:.1f} % within 1 cm and 2 deg), "
+                         f"median error {s['position_error_median'] * 100:.2f} cm, "
+                         f"{s['attitude_error_median']:.2f} deg, {s['episodes']} "
+                         f"{'targets' if kind != 'heldout_moving' else 'episodes'}")
+    return lines
 
 
 def read_reports(out_dir: str, label: str) -> dict:
@@ -275,7 +313,7 @@ def read_reports(out_dir: str, label: str) -> dict:
 
 
 def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optional[str],
-                    num_targets: Optional[int] = None, record: bool = True) -> Optional[dict]:
+                    num_targets: Optional[int] = None, record: bool = True, on_episode=None) -> Optional[dict]:
     """`evaluate_agent` for the lookup baseline (label `lookup`) on the arm; None on other domains.
 
     Action repeat 1: the lookup's input only changes with the target.
@@ -287,7 +325,8 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
     from agents.replay import ObservationFlattener
     flattener = ObservationFlattener(make_environment(domain, heldout_task, 0).observation_spec())
     return evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain,
-                          heldout_task, track_task, num_targets, env_steps=0, record=record, action_repeat=1)
+                          heldout_task, track_task, num_targets, env_steps=0, record=record, action_repeat=1,
+                          on_episode=on_episode)
 
 
 def write_json(path: str, obj) -> None:
@@ -355,6 +394,7 @@ def main(argv=None):
                         help=f"held-out targets (default: all; at most {MAX_TARGETS})")
     parser.add_argument("--no-rerun", action="store_true", help="no .rrd recordings")
     parser.add_argument("--no-figures", action="store_true", help="no PNG figures")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
     web_viewer.add_flags(parser)
     args = parser.parse_args(argv)
     out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.checkpoint)), "evaluation")
@@ -371,11 +411,16 @@ def main(argv=None):
     run = load_run_from_checkpoint(args.checkpoint)
     from agents.sac.builder import SACBuilder
     actor = SACBuilder.make_eval_actor(run.loop)
-    reports = {args.label: evaluate_agent(actor, run.loop.flattener, out, args.label, domain, heldout_task,
-                                          track_task or None, args.num_targets,
-                                          env_steps=run.loop.env_steps, record=not args.no_rerun,
-                                          action_repeat=run.config.action_repeat)}
-    lookup = evaluate_lookup(out, domain, heldout_task, track_task or None, args.num_targets, not args.no_rerun)
+    labels = 2 if domain.is_arm else 1  # the lookup beside the agent on the arm
+    with progress_lib.bar(not args.quiet, total=labels * episode_count(domain, args.num_targets, track_task),
+                          desc="evaluation", unit="episode", dynamic_ncols=True) as bar:
+        on_episode = bar.update if bar is not None else None
+        reports = {args.label: evaluate_agent(actor, run.loop.flattener, out, args.label, domain, heldout_task,
+                                              track_task or None, args.num_targets,
+                                              env_steps=run.loop.env_steps, record=not args.no_rerun,
+                                              action_repeat=run.config.action_repeat, on_episode=on_episode)}
+        lookup = evaluate_lookup(out, domain, heldout_task, track_task or None, args.num_targets,
+                                 not args.no_rerun, on_episode=on_episode)
     if lookup is not None:
         reports["lookup"] = lookup
     if not args.no_figures and "track" in reports[args.label]:
@@ -384,7 +429,9 @@ def main(argv=None):
                            os.path.join(out, f"{args.label}_track.png"))
     summary = {label: {kind: r["summary"] for kind, r in rs.items()} for label, rs in reports.items()}
     write_json(os.path.join(out, "summary.json"), summary)
-    print(json.dumps(summary, indent=1), flush=True)
+    print("\n".join(summary_lines(summary)), flush=True)
+    print(f"wrote {out}/: summary.json, reports" + ("" if args.no_figures or "track" not in reports[args.label]
+                                                    else f", {args.label}_track.png"), flush=True)
     if args.web:
         recordings = [os.path.join(out, f"{label}_track.rrd") for label in reports]
         web_viewer.serve([path for path in recordings if os.path.exists(path)], args.web_port)

@@ -140,15 +140,35 @@ def lesson_text(run) -> str:
 
 
 class Progress:
-    """tqdm bar over all environment steps of all runs: steps/s, run, lesson, recent return and success."""
+    """tqdm bar over all environment steps of all runs: steps/s, run, lesson, recent return and
+    success; then a second bar over the final evaluations' episodes (``evaluations`` of them)."""
 
-    def __init__(self, total: int, enabled: bool = True):
-        self.bar = None
+    def __init__(self, total: int, enabled: bool = True, evaluations: int = 0):
+        self.bar = self.eval_bar = None
+        self.enabled, self.evaluations = enabled, evaluations
         if enabled:
             from tqdm import tqdm
             self.bar = tqdm(total=total, unit="step", dynamic_ncols=True, smoothing=0.05)
         self.returns = deque(maxlen=20)
         self.successes = deque(maxlen=50)
+
+    def skip(self, n: int):
+        """n steps a resumed run had already taken: counted as done, not into the steps/s."""
+        if self.bar is not None and n:
+            self.bar.n += n
+            self.bar.last_print_n += n
+            self.bar.initial += n
+            self.bar.refresh()
+
+    def evaluated(self, n: int = 1):
+        """n more episodes of the final evaluations (the bar appears with the first)."""
+        if not self.enabled or not self.evaluations:
+            return
+        if self.eval_bar is None:
+            from tqdm import tqdm
+            self.eval_bar = tqdm(total=self.evaluations, desc="final evaluation", unit="episode",
+                                 dynamic_ncols=True, position=1)
+        self.eval_bar.update(n)
 
     def on_episode(self, record):
         self.returns.append(record["return"])
@@ -171,9 +191,12 @@ class Progress:
         self.returns.clear()
         self.successes.clear()
 
-    def close(self):
-        if self.bar is not None:
-            self.bar.close()
+    def close(self, cleared: bool = False):
+        """Close the bars (``cleared``: wipe them, the command stopped early)."""
+        for bar in (self.eval_bar, self.bar):
+            if bar is not None:
+                bar.leave = bar.leave and not cleared
+                bar.close()
 
 
 positive_int = cli_lib.whole_number(1, MAX_TOTAL_STEPS)  # environment steps
@@ -490,9 +513,10 @@ class LookupSpec:
     label: str = LOOKUP_LABEL
     total_steps: int = 0
 
-    def evaluate(self, job: RunJob) -> Optional[dict]:
+    def evaluate(self, job: RunJob, progress=None) -> Optional[dict]:
         return evaluation.evaluate_lookup(job.out_eval, job.domain, job.heldout_task, job.track_task,
-                                          job.final_eval_targets, record=job.record)
+                                          job.final_eval_targets, record=job.record,
+                                          on_episode=progress.evaluated if progress is not None else None)
 
 
 def final_targets(job: RunJob) -> Optional[int]:
@@ -534,7 +558,8 @@ def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
     reports = evaluation.evaluate_agent(SACBuilder.make_eval_actor(run.loop), run.loop.flattener, job.out_eval,
                                         run.name, job.domain, job.heldout_task, job.track_task, final_targets(job),
                                         env_steps=run.loop.env_steps, record=job.record,
-                                        action_repeat=config.action_repeat)
+                                        action_repeat=config.action_repeat,
+                                        on_episode=progress.evaluated if progress is not None else None)
     return {"reports": reports, "env_steps": run.loop.env_steps, "updates": run.loop.learner.num_updates,
             "timing": timing}
 
@@ -554,6 +579,9 @@ class _QueueProgress:
     def reset_window(self):
         pass
 
+    def evaluated(self, n: int = 1):
+        self.queue.put(("evaluated", self.label, n))
+
 
 def _worker(spec: RunSpec, job, queue):
     """One run in its own process: restore its latest checkpoint (if any), train, evaluate.
@@ -563,11 +591,11 @@ def _worker(spec: RunSpec, job, queue):
     signal.signal(signal.SIGINT, signal.default_int_handler)  # the parent started it ignored
     try:
         if isinstance(spec, LookupSpec):
-            spec.evaluate(job)
+            spec.evaluate(job, _QueueProgress(queue, label))
             outcome = {}
         else:
             run = spec.build(restore=True)
-            queue.put(("steps", label, (run.loop.env_steps, lesson_text(run))))  # where a resumed run starts
+            queue.put(("resumed", label, run.loop.env_steps))  # where a resumed run starts
             outcome = train_and_evaluate(run, job, _QueueProgress(queue, label))
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # done: a late request to stop changes nothing
         queue.put(("done", label, {k: v for k, v in outcome.items() if k != "reports"}))
@@ -666,6 +694,10 @@ def _supervise(context, specs, job, progress, workers, queue, active, ends):
             progress.advance(payload[0], label, payload[1])
         elif kind == "episode":
             progress.on_episode(payload)
+        elif kind == "evaluated":
+            progress.evaluated(payload)
+        elif kind == "resumed":
+            progress.skip(payload)
         elif label in active:  # the first word on how it ended
             ends[kind][label] = payload
             active.pop(label).join()
@@ -678,10 +710,15 @@ def main(argv=None):
     outputs.check_directory(args.out)  # before a minute of building, not after an hour of training
     setup = prepare(args, argv)
     init = check_run_directory(args, setup)
-    lock = lock_run_directory(args.out)  # noqa: F841  (held until this process ends)
-    specs, runs = start_runs(args, argv, setup, init)
-    outcomes, lookup = train_all(args, setup, specs, runs)
-    return report(args, setup, specs, outcomes, lookup)
+    with lock_run_directory(args.out):  # released, and its file removed, however this ends
+        finished = finished_summary(args, setup)
+        if finished is not None:  # a --resume of a finished run: its results, not a second evaluation
+            print(f"{args.out} is finished; nothing to resume")
+            print_summary(args.out, finished)
+            return finished
+        specs, runs = start_runs(args, argv, setup, init)
+        outcomes, lookup = train_all(args, setup, specs, runs)
+        return report(args, setup, specs, outcomes, lookup)
 
 
 @dataclasses.dataclass
@@ -823,8 +860,11 @@ def train_all(args, setup: _Setup, specs: dict, runs: dict):
                  eval_at=tuple(eval_at), num_eval_targets=args.num_eval_targets,
                  final_eval_targets=args.final_eval_targets, out_eval=os.path.join(args.out, "evaluation"),
                  record=not args.no_rerun, stop_at_step=args.stop_at_step)
-    progress = Progress(sum(spec.total_steps for spec in specs.values()), enabled=not args.quiet)
-    progress.bar and progress.bar.update(sum(r.loop.env_steps for r in runs.values()))
+    episodes = evaluation.episode_count(setup.domain, final_targets(job), setup.track_task)
+    progress = Progress(sum(spec.total_steps for spec in specs.values()), enabled=not args.quiet,
+                        evaluations=episodes * (len(specs) + setup.domain.is_arm))  # the lookup's too
+    progress.skip(sum(r.loop.env_steps for r in runs.values()))
+    stopped = True
     try:
         if _parallel(args, specs):  # the lookup's evaluation joins the workers' queue (a run's core once it is done)
             jobs = {**specs, LOOKUP_LABEL: LookupSpec()} if setup.domain.is_arm else specs
@@ -832,9 +872,10 @@ def train_all(args, setup: _Setup, specs: dict, runs: dict):
             lookup = outcomes.pop(LOOKUP_LABEL)["reports"] if setup.domain.is_arm else None
         else:
             outcomes = {label: train_and_evaluate(run, job, progress) for label, run in runs.items()}
-            lookup = LookupSpec().evaluate(job)
+            lookup = LookupSpec().evaluate(job, progress)
+        stopped = False
     finally:
-        progress.close()
+        progress.close(cleared=stopped)
     return outcomes, lookup
 
 
@@ -876,8 +917,26 @@ def report(args, setup: _Setup, specs: dict, outcomes: dict, lookup) -> dict:
                "updates": {label: o["updates"] for label, o in outcomes.items()},
                "timings": {label: o["timing"] for label, o in outcomes.items() if o["timing"]}}
     evaluation.write_json(os.path.join(args.out, "summary.json"), summary)
-    print(json.dumps(summary["runs"], indent=1))
+    print_summary(args.out, summary)
     return summary
+
+
+def print_summary(out: str, summary: dict) -> None:
+    """The run's results in a few lines (evaluation.summary_lines; the JSON is in summary.json) and where they are."""
+    print("\n".join(evaluation.summary_lines(summary["runs"])))
+    print(f"wrote {out}/: summary.json, evaluation/, checkpoints and records per run"
+          + (", figures/" if os.path.isdir(os.path.join(out, "figures")) else "")
+          + (", training.rrd" if os.path.exists(os.path.join(out, "training.rrd")) else ""))
+
+
+def finished_summary(args, setup: _Setup) -> Optional[dict]:
+    """On --resume, the summary.json of a run whose every run has trained its whole plan; else None."""
+    path = os.path.join(args.out, "summary.json")
+    if not args.resume or not os.path.exists(path):
+        return None
+    summary = parsing.read_json(path)
+    planned = {label: sum(l.steps for l in plan) for label, plan in setup.run_plans.items()}
+    return summary if summary.get("env_steps") == planned else None
 
 
 def cli(argv=None) -> int:
