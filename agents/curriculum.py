@@ -40,13 +40,13 @@ class LessonSettings:
     fresh_replay_lessons: Tuple[str, ...] = ()
 
     HELP: ClassVar[dict] = {  # one line per field, for a training command's --help
-        "her_lessons": "lessons that get hindsight goals, comma-separated (empty: every lesson)",
-        "long_horizon_lessons": "lessons trained with --long-horizon-discount",
+        "her_lessons": "lessons that get hindsight goals: tasks separated by commas, or all",
+        "long_horizon_lessons": "lessons trained with --long-horizon-discount: tasks separated by commas, or none",
         "long_horizon_discount": "discount of the long-horizon lessons",
-        "exploration_lessons": "lessons trained toward --exploration-target-entropy-per-action",
+        "exploration_lessons": "lessons trained toward --exploration-target-entropy-per-action (tasks, or none)",
         "exploration_target_entropy_per_action": "target entropy per action in the exploration lessons",
         "exploration_noise_correlation": "AR(1) correlation per step of the exploration lessons' noise (0: white)",
-        "fresh_replay_lessons": "lessons that start with an empty replay",
+        "fresh_replay_lessons": "lessons that start with an empty replay: tasks separated by commas, or none",
     }
     LESSON_LIST_FIELDS: ClassVar[tuple] = ("her_lessons", "long_horizon_lessons", "exploration_lessons",
                                            "fresh_replay_lessons")

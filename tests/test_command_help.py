@@ -53,3 +53,45 @@ def test_every_agent_setting_has_its_one_line_help():
         names = {f.name for f in dataclasses.fields(cls)}
         assert set(cls.HELP) == names, cls.__name__
         assert all(text and "\n" not in text and len(text) <= 110 for text in cls.HELP.values())
+
+
+SHOW_DEFAULTS = r'''
+import argparse, importlib, json
+from agents.robostrich.commands import COMMANDS
+
+class Caught(BaseException):
+    def __init__(self, parser):
+        self.parser = parser
+
+def catch(self, *args, **kwargs):
+    raise Caught(self)
+
+argparse.ArgumentParser.parse_args = argparse.ArgumentParser.parse_known_args = catch
+found = {}
+for prog, target in COMMANDS.items():
+    module, function = target.split(":")
+    try:
+        getattr(importlib.import_module(module), function)(["--help"])
+    except Caught as caught:
+        formatter = caught.parser._get_formatter()
+        found[prog] = {action.option_strings[-1]: formatter._expand_help(action) for action in caught.parser._actions
+                       if action.option_strings and action.help != argparse.SUPPRESS
+                       and action.default not in (None, argparse.SUPPRESS)
+                       and (action.nargs != 0 or isinstance(action, argparse.BooleanOptionalAction))}
+print(json.dumps(found))
+'''
+
+
+def test_every_flag_with_a_default_shows_it_in_words():
+    """A flag that takes a value (or --x/--no-x) and has a default says it; an empty default is
+    said in a word ('none', 'all'), never '(default: )'. Read from each command's own parser."""
+    import json
+    import subprocess
+    import sys
+    result = subprocess.run([sys.executable, "-c", SHOW_DEFAULTS], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-3000:]
+    helps = json.loads(result.stdout.strip().splitlines()[-1])
+    assert set(helps) == set(COMMANDS)
+    silent = {f"{prog} {flag}": text for prog, flags in helps.items() for flag, text in flags.items()
+              if "default" not in text or re.search(r"default: *[;)]", text)}
+    assert not silent, silent

@@ -69,7 +69,7 @@ def main(argv=None):
                                                                  args.steps, actions))
     print(f"raw mj_step x4        : {raw:10.0f} control steps/s")
     print(f"raw + gait targets    : {raw_gait:10.0f} control steps/s")
-    print(f"robostrich_a1/{args.task:8s}: {wrapped:10.0f} env steps/s "
+    print(f"robostrich_a1/{args.task:8s}: {wrapped:10.0f} control steps/s "
           f"(including resets every {quadruped_tasks.LESSON4_TIME_LIMIT:g} s)")
     print(f"ratio env/raw         : {wrapped / raw:10.3f}")
     print(f"ratio (raw+gait)/raw  : {raw_gait / raw:10.3f}")
@@ -80,7 +80,7 @@ def main(argv=None):
             f"{args.repeats} times for {args.steps} control steps, the best rate of each kept",
             [benchmarking.rate("raw mj_step x4", raw, "control steps/s"),
              benchmarking.rate("raw mj_step x4 + the gait's joint targets", raw_gait, "control steps/s"),
-             benchmarking.rate(f"robostrich_a1/{args.task}", wrapped, "env steps/s")],
+             benchmarking.rate(f"robostrich_a1/{args.task}", wrapped, "control steps/s")],
             [benchmarking.ratio(f"robostrich_a1/{args.task} / raw mj_step", wrapped / raw),
              benchmarking.ratio("raw + gait / raw mj_step", raw_gait / raw)])
         print(f"wrote {args.json}")

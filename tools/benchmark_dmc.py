@@ -40,9 +40,9 @@ def build_parser():
     p.add_argument("--tasks", default="reacher/easy,cartpole/swingup", help="comma-separated domain/task")
     p.add_argument("--seeds", type=lambda s: _ints(s, "--seeds"), default=[0], help="comma-separated (default 0)")
     p.add_argument("--steps", type=int, default=None,
-                   help="environment steps per task (default: reacher/easy 200000, cartpole/swingup 100000)")
+                   help="control steps per task (default: reacher/easy 200000, cartpole/swingup 100000)")
     p.add_argument("--eval-at", type=lambda s: _ints(s, "--eval-at"), default=[100_000, 200_000],
-                   help="evaluation points (environment steps); those beyond a task's budget are dropped")
+                   help="evaluation points (control steps); those beyond a task's budget are dropped")
     p.add_argument("--eval-episodes", type=int, default=10, help="deterministic episodes per evaluation")
     p.add_argument("--action-repeat", type=int, default=None, help="override the published action repeat")
     p.add_argument("--out", default="runs/dmc", help="writes dmc.json, dmc.md and one directory per run")
@@ -91,7 +91,7 @@ def reference_at(task: str, step: int):
 
 
 class Progress:
-    """tqdm over all environment steps of all runs, with the run and its recent training return."""
+    """tqdm over all control steps of all runs, with the run and its recent training return."""
 
     def __init__(self, total: int, enabled: bool):
         from tqdm import tqdm
@@ -114,7 +114,7 @@ class Progress:
 
 def format_table(rows) -> str:
     """Markdown: deterministic evaluation return per task, seed and step, beside the published one."""
-    lines = ["| task | seed | env steps | return (mean ± std) | episodes | published state SAC |",
+    lines = ["| task | seed | control steps | return (mean ± std) | episodes | published state SAC |",
              "|---|---|---|---|---|---|"]
     for r in rows:
         ref = "-" if r["reference"] is None else f"~{r['reference']}"
@@ -122,7 +122,7 @@ def format_table(rows) -> str:
                      f"{r['return_mean']:.1f} ± {r['return_std']:.1f} | {r['episodes']} | {ref} |")
     seeds = sorted({r["seed"] for r in rows})
     if len(seeds) > 1:
-        lines += ["", "| task | env steps | mean over seeds [min, max] | seeds |", "|---|---|---|---|"]
+        lines += ["", "| task | control steps | mean over seeds [min, max] | seeds |", "|---|---|---|---|"]
         for key in sorted({(r["task"], r["eval_step"]) for r in rows}):
             means = [r["return_mean"] for r in rows if (r["task"], r["eval_step"]) == key]
             lines.append(f"| {key[0]} | {key[1]} | {sum(means) / len(means):.1f} [{min(means):.1f}, {max(means):.1f}] "

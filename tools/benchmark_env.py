@@ -104,8 +104,8 @@ def main(argv=None):
             seconds[name].append(loop.run(args.steps))
     best = {name: args.steps / min(times) for name, times in seconds.items()}
     print(f"raw mj_step x{raw.substeps} : {best['raw']:10.0f} control steps/s (best round)")
-    print(f"bare dm_control: {best['bare']:10.0f} env steps/s (best round)")
-    print(f"robostrich/{args.task}: {best['env']:10.0f} env steps/s (best round)")
+    print(f"bare dm_control: {best['bare']:10.0f} control steps/s (best round)")
+    print(f"robostrich/{args.task}: {best['env']:10.0f} control steps/s (best round)")
     ratios = {name: round_ratio(seconds["raw"], seconds[name]) for name in ("bare", "env")}
     for name, (low, median, high) in ratios.items():
         print(f"ratio {name + '/raw':9s}: {median:10.3f} (median of {args.rounds} rounds; "
@@ -117,8 +117,8 @@ def main(argv=None):
             f"alternating in {args.rounds} rounds of {args.steps} control steps; each ratio the median of "
             "the rounds' ratios [quartiles], each rate the best round",
             [benchmarking.rate(f"raw mj_step x{raw.substeps}", best["raw"], "control steps/s"),
-             benchmarking.rate("bare dm_control environment", best["bare"], "env steps/s"),
-             benchmarking.rate(f"robostrich/{args.task}", best["env"], "env steps/s")],
+             benchmarking.rate("bare dm_control environment", best["bare"], "control steps/s"),
+             benchmarking.rate(f"robostrich/{args.task}", best["env"], "control steps/s")],
             [benchmarking.ratio("bare dm_control / raw mj_step", ratios["bare"][1], ratios["bare"][0],
                                 ratios["bare"][2]),
              benchmarking.ratio(f"robostrich/{args.task} / raw mj_step", ratios["env"][1], ratios["env"][0],

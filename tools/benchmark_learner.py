@@ -202,7 +202,7 @@ def main(argv=None):
                         "ours_repeat": lambda: repeat_loop.run(chunk)}, args.seconds * 4)
     ours_sps, raw_sps, repeat_sps = rates["ours"] * chunk, rates["raw"] * chunk, rates["ours_repeat"] * chunk
     plain_sps = rates["plain"] * (chunk // 5)
-    print("environment steps/s (acting, no learning):")
+    print("control steps/s (acting, no learning):")
     print(f"  ours (EnvironmentLoop)               {ours_sps:9.1f}")
     print(f"  plain loop (eager policy, lists)     {plain_sps:9.1f}   ratio ours/plain = {ours_sps / plain_sps:.1f}x")
     print(f"  raw env.step, fixed action           {raw_sps:9.1f}   ours reaches {ours_sps / raw_sps:.0%} of raw")
@@ -210,7 +210,7 @@ def main(argv=None):
     ud = config.update_to_data_ratio
     per_step = 1.0 / repeat_sps + ud / (args.action_repeat * results["ours"])
     print(f"training throughput estimate (action repeat {args.action_repeat}, {ud:g} update per transition): "
-          f"{1.0 / per_step:.0f} env steps/s")
+          f"{1.0 / per_step:.0f} control steps/s")
     if args.json:
         from robostrich_suite import benchmarking
         benchmarking.write_report(
@@ -220,8 +220,8 @@ def main(argv=None):
             "version in the same run; variants in interleaved rounds, the best round of each kept",
             [benchmarking.rate(f"learner, one jit with lax.scan x{k}", results["ours"], "updates/s"),
              benchmarking.rate("plain SAC update, each loss jitted", results["plain_jit_per_loss"], "updates/s"),
-             benchmarking.rate("EnvironmentLoop acting", ours_sps, "env steps/s"),
-             benchmarking.rate("raw env.step, fixed action", raw_sps, "env steps/s")],
+             benchmarking.rate("EnvironmentLoop acting", ours_sps, "control steps/s"),
+             benchmarking.rate("raw env.step, fixed action", raw_sps, "control steps/s")],
             [benchmarking.ratio("learner / plain SAC update, each loss jitted",
                                 results["ours"] / results["plain_jit_per_loss"]),
              benchmarking.ratio("learner / plain SAC update without jit", results["ours"] / results["plain_eager"]),

@@ -111,7 +111,7 @@ def learning_curves_figure(runs: Dict[str, List[dict]], evals: Dict[str, List[di
     _mark_lessons(axes, boundaries, _lesson_names(runs, len(boundaries) + 1), last_step)
     axes[1].set_ylim(*SUCCESS_LIMITS)
     for ax in axes:
-        ax.set_xlabel("environment steps")
+        ax.set_xlabel("control steps")
         ax.ticklabel_format(axis="x", style="sci", scilimits=(3, 3))  # "x10^3": no overlapping labels
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="best")
@@ -290,7 +290,7 @@ def _dress_seed_groups(fig, axes, labels_of_groups: List[str], lesson_boundaries
     _mark_lessons(axes[:2], boundaries, [f"lesson {i + 1}" for i in range(len(boundaries) + 1)]
                   if boundaries else [], last_step)
     for ax in axes[:2]:
-        ax.set_xlabel("environment steps")
+        ax.set_xlabel("control steps")
         ax.ticklabel_format(axis="x", style="sci", scilimits=(3, 3))
     axes[2].set_xticks(range(len(labels_of_groups)))
     axes[2].set_xticklabels([textwrap.fill(label, 12) for label in labels_of_groups], fontsize=8)

@@ -60,8 +60,8 @@ def main(argv=None) -> dict:
                                         "reports, a .rrd recording and a PNG written.")
     parser.add_argument("--policy", default="robostrich",
                         help=f"a shipped policy ({', '.join(policies.SHIPPED)}) or a .npz policy file "
-                             "(written by tools/export_policy.py)")
-    parser.add_argument("--out", default="robostrich_play", help="directory for the reports, .rrd and PNG")
+                             "(written by tools/export_policy.py; default: %(default)s)")
+    parser.add_argument("--out", default="robostrich_play", help="directory for the reports, .rrd and PNG (default: %(default)s)")
     parser.add_argument("--num-targets", type=evaluation.target_count, default=None,
                         help="held-out targets to try (default: all)")
     parser.add_argument("--no-rerun", action="store_true", help="write no .rrd recording")

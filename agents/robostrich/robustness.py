@@ -174,7 +174,7 @@ def build_parser() -> cli_lib.Parser:
                                         "increasing scale, then all at once. Writes robustness.json and .png.")
     parser.add_argument("policy", help=f"a shipped policy ({', '.join(policies.SHIPPED)}), a policy file (.npz) "
                                        "or a robostrich-train checkpoint (checkpoint.ckpt)")
-    parser.add_argument("--out", default="robostrich_robustness", help="directory for robustness.json and .png")
+    parser.add_argument("--out", default="robostrich_robustness", help="directory for robustness.json and .png (default: %(default)s)")
     parser.add_argument("--scales", type=scale_list, default=DEFAULT_SCALES,
                         help="scales s, comma-separated, 0 to 1 (default: %(default)s); what s means per family: "
                              "robostrich_suite/tasks/perturbations.py")

@@ -140,7 +140,7 @@ def lesson_text(run) -> str:
 
 
 class Progress:
-    """tqdm bar over all environment steps of all runs: steps/s, run, lesson, recent return and
+    """tqdm bar over all control steps of all runs: steps/s, run, lesson, recent return and
     success; then a second bar over the final evaluations' episodes (``evaluations`` of them)."""
 
     def __init__(self, total: int, enabled: bool = True, evaluations: int = 0):
@@ -199,7 +199,7 @@ class Progress:
                 bar.close()
 
 
-positive_int = cli_lib.whole_number(1, MAX_TOTAL_STEPS)  # environment steps
+positive_int = cli_lib.whole_number(1, MAX_TOTAL_STEPS)  # control steps
 
 
 def _json_object(text: str) -> dict:
@@ -218,7 +218,7 @@ def _add_run_arguments(run) -> None:
                      help="robostrich (the arm on its frame), robostrich_a1 (on the quadruped) or a dm_control "
                           "domain (default: %(default)s)")
     run.add_argument("--steps", type=positive_int, default=None,
-                     help="total environment steps of the curriculum (default "
+                     help="total control steps of the curriculum (default "
                           + "; ".join(f"{MAIN_JOB_STEPS[d]} on {d}, split "
                                       f"{':'.join(map(str, MAIN_JOB_LESSON_SHARES[d]))} "
                                       "over its lessons" for d in MAIN_JOB_STEPS)
@@ -252,7 +252,8 @@ def _add_run_arguments(run) -> None:
                           "\"fixed_stored_starts\": 0}' gives the paper's eq. 10, its uniform draw of targets and "
                           "its fixed starts in lessons 1-2)")
     run.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
-                     help="also train plain SAC on the final lesson with the same total budget")
+                     help="also train plain SAC on the final lesson with the same total budget (default: "
+                          "--baseline)")
     run.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS),
                      default=min(2, os.cpu_count() or 1),
                      help="runs trained at once, one process each (default: %(default)s; the curriculum and "
@@ -267,15 +268,16 @@ def _add_file_arguments(files) -> None:
                        help="also keep a checkpoint after every lesson but the last (RUN/after_lessonK.ckpt), "
                             "e.g. the lesson-3 policy to compare lesson 4 with (robostrich-stabilize --reference)")
     files.add_argument("--checkpoint-every", type=positive_int, default=25_000,
-                       help="environment steps between checkpoints (default: %(default)s)")
+                       help="control steps between checkpoints (default: %(default)s)")
 
 
 def _add_report_arguments(report) -> None:
     """robostrich-train's flags for the evaluations and what is written."""
     report.add_argument("--eval-every", type=positive_int, default=None,
-                        help="environment steps between held-out evaluations (default: steps/6)")
+                        help="control steps between held-out evaluations (default: steps/6)")
     report.add_argument("--num-eval-targets", type=evaluation.target_count, default=20,
-                        help="held-out targets in the periodic evaluations (the final one uses all)")
+                        help="held-out targets in the periodic evaluations (the final one uses all; "
+                             "default: %(default)s)")
     report.add_argument("--final-eval-targets", type=evaluation.target_count, default=None,
                         help="held-out targets in the final evaluation (default: all)")
     report.add_argument("--heldout-task", default=None,
@@ -317,8 +319,16 @@ def _config_flag(field_name: str) -> str:
     return "--" + field_name.replace("_", "-")
 
 
-def _shown(value) -> str:
+def _shown(value, field_name: str = "") -> str:
+    """A default as --help shows it: a tuple as its flag takes it, an empty lesson list by its keyword."""
+    if isinstance(value, tuple) and not value and field_name in LessonSettings.LESSON_LIST_FIELDS:
+        return _EMPTY_LESSONS[field_name == "her_lessons"]
     return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
+
+
+# An empty lesson list means every lesson for hindsight goals and no lesson for the rest
+# (LessonSettings): on the command line each is said in a word, `all` or `none`.
+_EMPTY_LESSONS = {True: "all", False: "none"}
 
 
 def add_config_arguments(group, defaults):
@@ -327,29 +337,36 @@ def add_config_arguments(group, defaults):
     for field in dataclasses.fields(defaults):
         default = getattr(defaults, field.name)
         flag = _config_flag(field.name)
-        help_text = f"{type(defaults).HELP[field.name]} (default: {_shown(default)}"
+        help_text = f"{type(defaults).HELP[field.name]} (default: {_shown(default, field.name)}"
         for domain, values in MAIN_JOB_CONFIG.items():
             if field.name in values:
-                help_text += f"; on {domain}: {_shown(values[field.name])}"
+                help_text += f"; on {domain}: {_shown(values[field.name], field.name)}"
         help_text += ")"
         if isinstance(default, bool):
             group.add_argument(flag, dest=field.name, action=argparse.BooleanOptionalAction,
                                default=default, help=help_text)
         elif isinstance(default, tuple):
             item_type = typing.get_args(typing.get_type_hints(type(defaults))[field.name])[0]
-            group.add_argument(flag, dest=field.name, type=_comma_list(item_type),
-                               default=",".join(map(str, default)), help=help_text)
+            group.add_argument(flag, dest=field.name, type=_comma_list(item_type, field.name),
+                               default=_shown(default, field.name), help=help_text)
         elif default is None:
             group.add_argument(flag, dest=field.name, type=float, default=None, help=help_text)
         else:
             group.add_argument(flag, dest=field.name, type=type(default), default=default, help=help_text)
 
 
-def _comma_list(item_type):
+def _comma_list(item_type, field_name: str = ""):
     """argparse type of a tuple field: the text as given once every item reads as ``item_type``,
-    else a usage error naming the flag (int's own words would not)."""
+    else a usage error naming the flag (int's own words would not). A lesson list's keyword
+    (`all` for hindsight goals, `none` for the rest) reads as the empty list it stands for."""
 
     def parse(text: str) -> str:
+        if field_name in LessonSettings.LESSON_LIST_FIELDS:
+            keyword = _EMPTY_LESSONS[field_name == "her_lessons"]
+            if text.strip() == keyword:
+                return ""
+            if not text.strip() and field_name == "her_lessons":  # elsewhere empty means none, as it says
+                raise argparse.ArgumentTypeError(f"name the lessons, separated by commas, or {keyword}")
         for item in filter(None, (part.strip() for part in text.split(","))):
             try:
                 item_type(item)

@@ -71,9 +71,10 @@ def build_parser() -> cli_lib.Parser:
                         help="search the passive joint stiffness too (0.5-4 N m/rad), fixed for a study")
     parser.add_argument("--start-from", nargs="+", default=[], metavar="LAYOUT",
                         help="built-in layouts or layout files tried first, when the study is new "
-                             "(each must be in the space: 1 dorsal + 8 ventral tendons through every link)")
+                             "(each must be in the space: 1 dorsal + 8 ventral tendons through every link; default: none)")
     parser.add_argument("--confirm", type=cli_lib.whole_number(0, 50), default=0, metavar="K",
-                        help="full measures of the front's best K routings (by gap column, then coverage)")
+                        help="full measures of the front's best K routings (by gap column, then coverage; "
+                             "default: %(default)s)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar, only the summary")
     return parser
 

@@ -30,6 +30,7 @@ import csv
 import dataclasses
 import json
 import pathlib
+import re
 import shlex
 import sys
 import time
@@ -270,6 +271,11 @@ def write_csv(path: pathlib.Path, rows) -> None:
 
 # --------------------------------------------------------------------------- command line
 
+def _plain(docstring: str) -> str:
+    """A layout's docstring as --help text: one line, Sphinx roles as their names, no final stop."""
+    return re.sub(r":\w+:`~?([^`]+)`", r"\1", " ".join(docstring.split())).rstrip(".")
+
+
 def build_parser() -> cli_lib.Parser:
     """The command's options; the agent's side (agents/robostrich/layouts.py) adds its own."""
     parser = cli_lib.Parser(
@@ -280,7 +286,7 @@ def build_parser() -> cli_lib.Parser:
                     "and, from the agent's side, held-out success of the lookup baseline (and, "
                     "with --train, of a short curriculum run). Writes layouts.md, layouts.csv, layouts.png and "
                     "targets/LAYOUT.npz under --out.",
-        epilog="built-in layouts: " + "; ".join(f"{name}: {b.description}"
+        epilog="built-in layouts: " + " ".join(f"{name}: {_plain(b.description)}."
                                                  for name, b in layouts_lib.BUILT_IN.items()))
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/layouts"),
                         help="output directory (default: %(default)s)")
@@ -294,7 +300,7 @@ def build_parser() -> cli_lib.Parser:
                              + ") instead of --layouts")
     parser.add_argument("--layout-file", nargs="+", default=[], type=pathlib.Path, metavar="FILE",
                         help="also compare layouts from JSON/TOML files (see "
-                             "robostrich_suite/model/layouts.py for the format)")
+                             "robostrich_suite/model/layouts.py for the format; default: none)")
     parser.add_argument("--stiffness", nargs="+", type=cli_lib.number(1e-6, 1e4, " N m/rad"), default=[],
                         metavar="N_M_PER_RAD",
                         help="passive joint stiffnesses to sweep, every layout at each "

@@ -390,9 +390,10 @@ def build_parser() -> cli_lib.Parser:
                         metavar="K", help="ventral slips tied K joints caudal of their "
                         "insertions (TendonLayout.ventral_slips) (default: %(default)s)")
     parser.add_argument("--dorsal", type=cli_lib.number(-0.5, 0.5, " m"), default=defaults.dorsal,
-                        help="dorsal contraction held throughout, m (default: %(default)s)")
+                        help="dorsal contraction held throughout, m; a contraction is the tendon's shortening "
+                             "from its length at zero input: positive pulls, negative pays it out (default: %(default)s)")
     parser.add_argument("--amplitude", type=cli_lib.number(-0.5, 0.5, " m"), default=defaults.amplitude,
-                        help="ventral contraction per tendon, m (default: %(default)s)")
+                        help="ventral contraction per tendon, m, signed as --dorsal (default: %(default)s)")
     parser.add_argument("--ramp-time", type=cli_lib.seconds(maximum=MAX_RAMP_TIME), default=defaults.ramp_time,
                         help="seconds per ventral tendon (default: %(default)s)")
     parser.add_argument("--dorsal-hold", choices=("length", "input"),

@@ -153,7 +153,7 @@ def main(argv=None) -> None:
     parser.add_argument("--out", type=pathlib.Path, required=True,
                         help="target file to write (the shipped one: robostrich_suite/data/level_head_poses.npz)")
     parser.add_argument("--seek-level-time", type=cli_lib.seconds(allow_zero=True), default=SEEK_LEVEL_TIME,
-                        help="seconds of dorsal tuning towards a level head per draw (0: off)")
+                        help="seconds of dorsal tuning towards a level head per draw (0: off; default: %(default)s)")
     parser.add_argument("--append", action="store_true",
                         help="add to the poses already in --out (use a new --seed)")
     parser.add_argument("--recheck", action="store_true",

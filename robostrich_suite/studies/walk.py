@@ -157,11 +157,11 @@ def main(argv=None) -> None:
         description="Walk the quadruped with the arm on it; write walk.rrd and walk.png under --out "
                     "(trunk and head height, speed and attitude over time).")
     parser.add_argument("--task", default="head_stabilize", choices=list(SUITE),
-                        help="robostrich_a1 task whose gait and trunk heights to run")
+                        help="robostrich_a1 task whose gait and trunk heights to run (default: %(default)s)")
     parser.add_argument("--seconds", type=_at_least_one_step, default=12.0,
                         help="simulated time, at least one control step (default: %(default)s)")
     parser.add_argument("--tendons", default="zero", choices=["zero", "sine"],
-                        help="scripted tendon input (zero: the passive neck)")
+                        help="scripted tendon input (zero: the passive neck; default: %(default)s)")
     parser.add_argument("--gait", default=None,
                         help="gait file (CSV, see robostrich_suite.tasks.gait) or 'trot' for the "
                              "generator; default: the shipped file")
