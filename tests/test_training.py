@@ -210,7 +210,7 @@ def test_lesson_checkpoints_hold_the_policy_after_each_lesson(tmp_path):
 
 
 def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_elsewhere():
-    """The defaults are the measured recipe (docs/learning.md) on the arm domains: antagonist_pairs,
+    """The defaults are the measured recipe (docs/training.md#the-main-job) on the arm domains: antagonist_pairs,
     -2 entropy per tendon, HER in lesson 1, the precision term; dm_control plans get none of the
     arm's settings, and the paper's routing and eq. 10 stay one flag away."""
     from agents.robostrich.domains import Domain

@@ -76,7 +76,7 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
     # the baseline has the same total budget, on the final lesson alone
     recorded = json.load(open(os.path.join(out, "config.json")))
     assert recorded["plans"]["baseline"] == "robostrich/lesson3:750"
-    # the main job's defaults on the arm: the layout it learns and the precision term (docs/learning.md)
+    # the main job's defaults on the arm: the layout it learns and the precision term (docs/training.md#the-main-job)
     assert recorded["layout"] == "ventral_slips"  # the tasks' own routing, by name
     assert recorded["task_kwargs"] == {"weights": {"position_precision": 1.0, "attitude_precision": 0.5},
                                        "target_sampling": "failures", "fixed_stored_starts": 0.25}

@@ -52,7 +52,7 @@ def build_parser():
     g.add_argument("--batch-size", type=int, default=256, help="transitions per update (default: %(default)s)")
     # A critic that learns fast: lr 1e-3, layer-normalised critics, two updates per transition
     # (Acme's 3e-4, no normalisation and one update reached 445 on reacher/easy at 100k, this 907;
-    # docs/learning.md).
+    # docs/log/learning.md#the-learner-on-dm_control-2026-11-30-and-2026-12-01).
     g.add_argument("--learning-rate", type=float, default=1e-3,
                    help="of critics, actor and temperature (default: %(default)s)")
     g.add_argument("--critic-layer-norm", action=argparse.BooleanOptionalAction, default=True,

@@ -1,4 +1,4 @@
-"""Compare training configurations over seeds in one figure (docs/learning.md's pictures).
+"""Compare training configurations over seeds in one figure (docs/log/learning.md's pictures).
 
     python tools/compare_runs.py --out docs/her_lesson1.png \
         "eq. 10 + precision=runs/P1_s*" "+ HER in lesson 1=runs/P1_H1_s*"

@@ -7,7 +7,8 @@ lookup table, agents/robostrich/lookup.py) is held for one `lesson2` episode fro
 constant Gaussian error added to each tendon (standard deviation = a fraction of that tendon's
 half-range), `--draws` times per error size.  Success is the task's (0.05 m, 5 deg at the episode's
 end).  It tells what an agent that outputs absolute inputs must achieve: why a policy network whose
-outputs are off by a percent of the range loses most targets (docs/learning.md).  Writes OUT/
+outputs are off by a percent of the range loses most targets
+(docs/log/learning.md#why-the-learner-stays-below-the-lookup-the-arm-asks-for-inputs-right-to-1--2026-11-30).  Writes OUT/
 sensitivity.md (Markdown table) and sensitivity.json.
 """
 import argparse

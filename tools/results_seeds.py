@@ -99,8 +99,10 @@ def budget(data: dict) -> str:
 
 
 def caption(data: dict) -> str:
+    minutes = [m for m in data.get("minutes", []) if m is not None]
+    spent = f"; wall-clock per seed {min(minutes):.1f}-{max(minutes):.1f} min" if minutes else ""
     return (f"mean [min, max] over seeds {', '.join(map(str, data['seeds']))}; "
-            f"control steps per run: {budget(data)}")
+            f"control steps per run: {budget(data)}{spent}")
 
 
 def full(data: dict) -> list:

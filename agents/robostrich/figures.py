@@ -225,7 +225,7 @@ def plot_track(reports: Dict[str, dict], path: str):
 
 def seed_groups_figure(groups: Dict[str, List[dict]], lookup: Dict[str, float] = None,
                        lesson_boundaries=None):
-    """Training configurations compared over seeds, the way docs/learning.md reads them:
+    """Training configurations compared over seeds, the way docs/log/learning.md reads them:
     (a) periodic held-out success and (b) held-out median position error along training (mean
     over seeds, the min-max band shaded), (c) the final held-out success of every seed, from the
     fixed start and from moving starts.

@@ -12,7 +12,7 @@ from agents.sac.config import SACConfig
 DEFAULT_DOMAIN = "robostrich"
 # What changes with the lesson unless a run says otherwise (robostrich-train's defaults too): hindsight
 # goals in lesson 1 only (without them some seeds never learn the upper workspace; in lessons 2-3
-# they hurt: docs/learning.md).
+# they hurt: docs/log/learning.md#hindsight-goals-in-lesson-1-only-every-seed-learns-the-whole-workspace-2026-11-30).
 DEFAULT_LESSONS = LessonSettings(her_lessons=("lesson1",))
 
 

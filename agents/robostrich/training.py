@@ -40,13 +40,15 @@ DEFAULT_TOTAL_STEPS = 480_000  # per run, split evenly over the lessons; the two
 # policy refines its reach from moving starts, gets the longest share (280k of 600k), training with
 # a narrower policy Gaussian (target entropy -3 per action instead of -2: about 1 % of an input's
 # range instead of 3 %, where a held input 1 % off already costs a target): the long, quiet lesson is
-# what makes the reach precise (docs/learning.md).
+# what makes the reach precise
+# (docs/log/learning.md#a-longer-quieter-lesson-3-714--within-1-cm-and-2-deg-on-every-seed-2026-12-02).
 # On the quadruped (Algorithm 1 as the paper ran it) lessons 1-3 on the standing quadruped get the
 # frame's 600k, then lesson 4 (trotting, the trunk height changing) 150k more.
 MAIN_JOB_STEPS = {"robostrich": 600_000, "robostrich_a1": 750_000}
 MAIN_JOB_LESSON_SHARES = {"robostrich": (4, 4, 7), "robostrich_a1": (16, 16, 28, 15)}  # of the curriculum, in order
 # Lesson 4 starts with an empty replay: continuing on the standing lessons' transitions, its own
-# success fell while it trained, and with it the standing targets (docs/quadruped.md).
+# success fell while it trained, and with it the standing targets
+# (docs/log/quadruped.md#2026-12-03-hindsight-goals-were-off-lesson-4-after-them-the-head-speed-term).
 _NARROW_LESSON3 = {"exploration_lessons": ("lesson3",), "exploration_target_entropy_per_action": -3.0}
 MAIN_JOB_CONFIG = {"robostrich": _NARROW_LESSON3,  # LessonSettings fields
                    "robostrich_a1": {**_NARROW_LESSON3, "fresh_replay_lessons": ("lesson4",)}}
@@ -62,7 +64,8 @@ DEFAULT_ARM_LAYOUT = layouts.DEFAULT
 # at rest at a stored pose (Reach fixed_stored_starts), so that lesson 3 takes over a learner that
 # has already moved out of its curled starts, which every low-to-high move needs; and the same
 # Gaussian term for the head's attitude (1 deg scale), which holds the head level well inside the
-# 5 deg tolerance (docs/learning.md). '{"weights": {"position_precision": 0, "attitude_precision": 0},
+# 5 deg tolerance (docs/log/learning.md#the-attitude-precision-term-becomes-the-default-24-of-24-track-targets-2026-12-01
+# and the sections below it). '{"weights": {"position_precision": 0, "attitude_precision": 0},
 # "target_sampling": "uniform", "fixed_stored_starts": 0}' gives the paper's eq. 10, draw and
 # starts. Evaluation keeps the task's defaults.
 DEFAULT_ARM_TASK_KWARGS = {"weights": {"position_precision": 1.0, "attitude_precision": 0.5},
@@ -74,7 +77,8 @@ FIXED_START_ARM_TASK_KWARGS = {**DEFAULT_ARM_TASK_KWARGS, "fixed_stored_starts":
 
 # On the quadruped a quarter of lesson 4's episodes stand (the standing lessons rehearsed): trained
 # on trotting alone, the policy could lose standing targets it had held after lesson 3
-# (docs/quadruped.md). The standing lessons ignore the option.
+# (docs/log/quadruped.md#2026-12-04-lesson-4-rehearses-standing-what-limits-the-heads-vertical-speed).
+# The standing lessons ignore the option.
 QUADRUPED_TASK_KWARGS = {"standing_share": 0.25}
 
 

@@ -13,7 +13,7 @@ class SACConfig:
     fingerprint, so a checkpoint is never resumed under different settings.
     """
 
-    # Defaults chosen by measurement (docs/learning.md; a training command may generate its flags
+    # Defaults chosen by measurement (docs/training.md#the-main-job; a training command may generate its flags
     # from these fields). SACConfig.paper_sac() gives the paper's / Acme's plain SAC.
     batch_size: int = 64
     learning_rate: float = 1e-3  # critics, actor and temperature alike
@@ -22,7 +22,7 @@ class SACConfig:
     # The entropy the temperature steers the policy to: `target_entropy` if given, else
     # `target_entropy_per_action` x |A|. Acme's -1 per action leaves an exploration noise of about
     # 9 % of each action's half-range; -2 (about 3 %) suits tasks that need their actions right to
-    # about 1 % (docs/learning.md).
+    # about 1 % (docs/log/learning.md#the-recipe-becomes-the-default-the-main-job-over-3-seeds-2026-11-30).
     target_entropy: Optional[float] = None
     target_entropy_per_action: float = -2.0
     # Acme starts at 1; on rewards of a few units per step that entropy bonus outweighs the task
@@ -61,14 +61,15 @@ class SACConfig:
     # Weight of a penalty on the squared pre-tanh mean of the policy in the actor loss (the
     # original SAC code's mean regulariser, 1e-3 there; 0 = off, plain SAC). An action whose
     # mean sits deep in the tanh's saturation gets almost no gradient from the critic (at 2.9:
-    # 1 - tanh^2 = 0.012); this pulls it back where the critic can move it (docs/learning.md).
+    # 1 - tanh^2 = 0.012); this pulls it back where the critic can move it
+    # (docs/log/learning.md#a-tendon-stuck-in-the-tanhs-saturation-a-penalty-on-the-pre-tanh-mean-2026-12-01).
     pre_tanh_penalty: float = 0.1
     # Evaluate (and deploy) an exponential moving average of the policy's parameters, updated
     # with this rate after every gradient step (0 = off: the last policy, as the paper). The
     # agent still explores with its current policy, so training is unchanged bit for bit; the
     # average smooths the update-to-update wobble that moves a held-out target in or out of
     # the tolerance from one evaluation to the next: 1e-4 is about the last 10k updates
-    # (docs/learning.md).
+    # (docs/log/learning.md#snapshot-noise-a-longer-budget-and-a-moving-average-policy-2026-12-01).
     policy_average: float = 1e-4
     # ... but early on, while 1 / policy_average is more updates than the run has made, the
     # average spans about this fraction of the updates so far (rate max(policy_average,

@@ -280,7 +280,8 @@ class _QuadrupedTaskMixin:
         obs["joint_angles"] = shared["joint_angles"]
         # In the trunk frame, as every position here: (0, 0, height). The distance walked since
         # the episode start is no input: a policy trained on 6 s episodes (lesson 4) meets
-        # distances it never saw in 12 s ones and lets the head drift (docs/quadruped.md).
+        # distances it never saw in 12 s ones and lets the head drift
+        # (docs/log/quadruped.md#2026-12-01-the-distance-walked-leaves-the-observation-lesson-4-in-its-own-run).
         obs["trunk_position"] = np.array([0.0, 0.0, physics.trunk_height()])
         obs["trunk_velocity"] = physics.to_trunk_frame(physics.trunk_velocity(), velocity=True)
         for key, value in shared.items():

@@ -30,16 +30,17 @@ class RewardWeights:
 
     ``action_change`` (per metre, not in the paper; 0 by default) weighs the mean absolute change
     of the tendon inputs from one control step to the next in eq. 10's reward: a policy that
-    shakes its inputs at the control rate (as lesson 4 taught on the quadruped,
-    ``docs/quadruped.md``) pays for it.  It depends on the action, not on the goal, so replayed
-    rewards recomputed for other goals (hindsight, ``relabel_rewards``) cannot keep it: the agent
-    refuses it with either on.
+    shakes its inputs at the control rate (as lesson 4 taught on the quadruped:
+    docs/log/quadruped.md#2026-12-01-the-distance-walked-leaves-the-observation-lesson-4-in-its-own-run)
+    pays for it.  It depends on the action, not on the goal, so replayed rewards recomputed for
+    other goals (hindsight, ``relabel_rewards``) cannot keep it: the agent refuses it with either on.
 
     ``head_vertical_speed`` (per m/s, not in the paper; 0 by default) weighs the head's vertical
     speed in the world while the head is within the position tolerance of its target: on the
     walking quadruped, the bobbing Sec. 5.2.1 asks the arm to cancel once it holds the target
-    (charged on the way there too, it taught the head not to move: docs/quadruped.md). Like
-    ``action_change`` the replay cannot recompute it for other goals.
+    (charged on the way there too, it taught the head not to move:
+    docs/log/quadruped.md#2026-12-03-hindsight-goals-were-off-lesson-4-after-them-the-head-speed-term).
+    Like ``action_change`` the replay cannot recompute it for other goals.
     """
     position_miss: float = 1.0
     attitude_miss: float = 1.0
