@@ -24,6 +24,11 @@ Keyword arguments other than ``render_mode``, ``seed``, ``normalize_actions``,
 frame from the model's ``side`` camera; it needs an offscreen OpenGL backend
 (``MUJOCO_GL=egl``, or ``osmesa`` with libOSMesa installed), which
 ``robostrich_suite`` picks itself when no display is set.
+
+``info`` (from ``reset`` and every ``step``) holds what the reaching tasks measure:
+``is_success`` (the task's own test: the head within its position and attitude tolerances),
+``position_error`` (m), ``attitude_error`` (deg, signed: positive = head pitched down) and
+``target`` (x, z in m); plus ``divergence`` on the step where the physics diverged.
 """
 from __future__ import annotations
 
@@ -87,7 +92,17 @@ class GymnasiumEnv(gymnasium.Env):
                 forget()
         timestep = self.dm_env.reset()
         self._episode_over = False
-        return self._flatten(timestep.observation), {}
+        return self._flatten(timestep.observation), self._measures()
+
+    def _measures(self) -> dict:
+        """What the task measures now (gymnasium's ``info``): success and the head's errors, for a
+        task with a target (every reaching task); nothing for one without."""
+        task, physics = self.dm_env.task, self.dm_env.physics
+        if not all(hasattr(task, name) for name in ("is_success", "position_error", "attitude_error")):
+            return {}
+        return {"is_success": bool(task.is_success(physics)), "position_error": float(task.position_error(physics)),
+                "attitude_error": float(task.attitude_error(physics)),
+                "target": np.array(task.target_position, np.float64)}
 
     def to_dm_action(self, action) -> np.ndarray:
         """The dm_env action (contractions in metres) for a gymnasium action."""
@@ -105,7 +120,7 @@ class GymnasiumEnv(gymnasium.Env):
         self._episode_over = timestep.last()
         terminated = timestep.last() and timestep.discount == 0.0
         truncated = timestep.last() and not terminated
-        info = {}
+        info = self._measures()
         if getattr(self.dm_env.physics, "divergence", None):
             info["divergence"] = self.dm_env.physics.divergence
         return (self._flatten(timestep.observation), float(timestep.reward), bool(terminated),

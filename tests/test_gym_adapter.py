@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from robostrich_suite import gym_adapter
+from robostrich_suite import gym_adapter, targets
 
 
 def test_passes_gymnasiums_checker():
@@ -132,3 +132,23 @@ def test_osmesa_without_its_library_is_a_clear_import_error():
         last = result.stderr.strip().splitlines()[-1]
         assert result.returncode != 0 and last.startswith("ImportError: "), result.stderr[-2000:]
         assert "MUJOCO_GL='osmesa'" in last and "libosmesa6" in last and "MUJOCO_GL=egl" in last
+
+
+def test_info_holds_the_tasks_success_and_errors():
+    """info carries what the task measures: its success test and the head's errors, as gymnasium
+    users (HER's is_success) expect. Holding a stored level pose's inputs reaches that pose."""
+    poses = targets.level_head_poses()
+    target, inputs = poses["head_position"][0], poses["control"][0]
+    env = gym_adapter.make("robostrich", "lesson2", seed=0, normalize_actions=False,
+                           target_pool=np.asarray([target]))
+    obs, info = env.reset(seed=0)
+    assert set(info) == {"is_success", "position_error", "attitude_error", "target"} and not info["is_success"]
+    np.testing.assert_allclose(info["target"], target)
+    done = False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(inputs.astype(np.float32))
+        done = terminated or truncated
+        to_target = obs[env.observation_slices["to_target"]]
+        assert info["position_error"] == pytest.approx(float(np.linalg.norm(to_target)), abs=1e-6)
+        assert info["is_success"] == (info["position_error"] <= 0.05 and abs(info["attitude_error"]) <= 5.0)
+    assert info["is_success"] and info["position_error"] < 0.02, info
