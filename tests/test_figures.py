@@ -171,6 +171,22 @@ def test_track_figure_numbers_the_targets_and_labels_tolerances(passive_arm_repo
         plt.close(fig)
 
 
+def test_track_figure_names_each_run_with_its_outcome_against_the_goal(passive_arm_reports):
+    """One legend below the panels: each run by its name (plain SAC, not 'baseline'), its seed and
+    budget where given, and how many targets it reached; the title states the goal."""
+    track = passive_arm_reports["track"]
+    reached = sum(bool(segment["success"]) for segment in track["segments"])
+    fig = figures.track_figure({"baseline": track, "lookup": track}, notes={"baseline": "seed 2, 600k control steps"})
+    try:
+        runs = [t.get_text() for t in fig.legends[0].get_texts()]
+        assert runs == [f"plain SAC (final lesson only) (seed 2, 600k control steps): {reached} of 3 reached",
+                        f"lookup (no learning): {reached} of 3 reached"]
+        assert not any(label in _legend_labels(ax) for ax in fig.axes for label in runs)
+        assert "goal: each reached, within 50 mm and 5 deg of level" in fig._suptitle.get_text()
+    finally:
+        plt.close(fig)
+
+
 def _seed_run(seed, curve, final, moving):
     """What compare_runs reads from one robostrich-train directory (numbers chosen so the
     means and bands are known exactly)."""

@@ -176,17 +176,33 @@ def _plot_targets_in_order(ax, report: dict) -> None:
                     fontsize=10, fontweight="bold")
 
 
-def track_figure(reports: Dict[str, dict]):
-    """Fig. 7a, c, d: (a) head path, (b) position error and (c) head attitude over the `track` task."""
+# How a figure names the runs of robostrich-train (its run directories' labels)
+RUN_NAMES = {"curriculum": "curriculum SAC", "baseline": "plain SAC (final lesson only)", "lookup": "lookup (no learning)"}
+
+
+def _track_label(label: str, report: dict, note: str = None) -> str:
+    """'curriculum SAC (seed 2, 600k control steps): 3 of 3 reached': the run against the goal."""
+    segments = report.get("segments", [])
+    reached = sum(bool(seg.get("success")) for seg in segments)
+    name = RUN_NAMES.get(label, label) + (f" ({note})" if note else "")
+    return f"{name}: {reached} of {len(segments)} reached" if segments else name
+
+
+def track_figure(reports: Dict[str, dict], notes: Dict[str, str] = None):
+    """Fig. 7a, c, d: (a) head path, (b) position error and (c) head attitude over the `track` task.
+    Each run's legend entry says how many targets it reached (the goal: all); ``notes`` (label ->
+    text, e.g. its seed and budget) are added to its name."""
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    runs = {}  # legend label -> its line in (b)
     for i, (label, report) in enumerate(reports.items()):
         s = report["series"]
         t = np.asarray(s["time"])
+        label = _track_label(label, report, (notes or {}).get(label))
         if s.get("head_position"):
             hp = np.asarray(s["head_position"])
             axes[0].plot(hp[:, 0], hp[:, 1], color=f"C{i}", label=label)
             axes[0].plot(*hp[0], "o", color=f"C{i}", mfc="w", ms=7)
-        axes[1].plot(t, s["position_error"], color=f"C{i}", label=label)
+        runs[label], = axes[1].plot(t, s["position_error"], color=f"C{i}", label=label)
         if s.get("head_attitude"):
             axes[2].plot(t, s["head_attitude"], color=f"C{i}", label=label)
     any_report = next(iter(reports.values()))
@@ -208,19 +224,23 @@ def track_figure(reports: Dict[str, dict]):
     axes[1].set_title("(b) distance from the current target", fontsize=10)
     axes[2].set_xlabel("time (s)"); axes[2].set_ylabel("head attitude (deg, 90 = level)")
     axes[2].set_title("(c) head attitude", fontsize=10)
-    for ax in axes:
+    for ax in axes:  # the panels' own marks; the runs, with their outcome, in one legend below
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8, loc="best")
+        handles, labels = ax.get_legend_handles_labels()
+        ax.legend([h for h, l in zip(handles, labels) if l not in runs],
+                  [l for l in labels if l not in runs], fontsize=8, loc="best")
+    fig.legend(list(runs.values()), list(runs), loc="lower center", ncol=len(runs), fontsize=9, frameon=False)
     where = f"{any_report['domain']}/{any_report['task']}" if "task" in any_report else "track"
-    fig.suptitle(f"Tracking ({where}): the head visits {len(any_report['segments'])} targets in turn",
-                 fontsize=11)
-    fig.tight_layout()
+    fig.suptitle(f"Tracking ({where}): the head visits {len(any_report['segments'])} targets in turn; goal: "
+                 f"each reached, within {1000 * position_tolerance:.0f} mm and {attitude_tolerance:.0f} deg of level "
+                 "at the end of its turn", fontsize=11)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
     return fig
 
 
-def plot_track(reports: Dict[str, dict], path: str):
+def plot_track(reports: Dict[str, dict], path: str, notes: Dict[str, str] = None):
     """Write :func:`track_figure` to ``path`` (PNG)."""
-    _save(track_figure(reports), path)
+    _save(track_figure(reports, notes), path)
 
 
 def seed_groups_figure(groups: Dict[str, List[dict]], lookup: Dict[str, float] = None,
