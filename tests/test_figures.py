@@ -143,6 +143,10 @@ def test_learning_curves_have_titles_labelled_lines_and_a_whole_success_axis(pas
         low, high = fig.axes[1].get_ylim()
         assert low <= 0 < 1 <= high and high - low < 1.2
         assert "position tolerance (50 mm)" in _legend_labels(fig.axes[2])
+        # (b) compares held-out with held-out: the evaluations' success, training episodes only behind it
+        assert {"curriculum SAC, held-out", "curriculum SAC, training episodes"} <= set(_legend_labels(fig.axes[1]))
+        held_out = next(line for line in fig.axes[1].lines if line.get_label() == "curriculum SAC, held-out")
+        assert list(held_out.get_ydata()) == [e["summary"]["success_rate"] for e in data["evals"]]
         for ax in fig.axes:
             assert "lesson change" in _legend_labels(ax)
             names = {t.get_text(): t.get_position()[0] for t in ax.texts}

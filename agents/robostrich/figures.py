@@ -19,6 +19,8 @@ from robostrich_suite import files  # noqa: E402
 
 # A rate: always its whole range, so 0 % reads as 0 %; room above 1 for the lesson names.
 SUCCESS_LIMITS = (-0.03, 1.1)
+# How a figure names the runs of robostrich-train (its run directories' labels)
+RUN_NAMES = {"curriculum": "curriculum SAC", "baseline": "plain SAC (final lesson only)", "lookup": "lookup (no learning)"}
 
 
 def _smooth(x, n):
@@ -77,10 +79,11 @@ def _mark_lessons(axes, boundaries, names, last_step) -> None:
 
 def learning_curves_figure(runs: Dict[str, List[dict]], evals: Dict[str, List[dict]],
                            lesson_boundaries=None, baselines: Dict[str, dict] = None):
-    """Fig. 7b: (a) training return and (b) success per episode, (c) held-out position error,
-    curriculum vs SAC.
+    """Fig. 7b: (a) training return, (b) held-out success at each evaluation (training episodes'
+    success faded behind it), (c) held-out position error, curriculum vs SAC.
 
-    `baselines` (label -> held-out summary, e.g. the lookup's) are dashed horizontal lines: the bar to clear.
+    `baselines` (label -> held-out summary, e.g. the lookup's) are dashed horizontal lines: the bar to
+    clear, held-out against held-out.
     Domains without position errors (e.g. reacher) show the evaluation return instead.
     """
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
@@ -93,14 +96,19 @@ def learning_curves_figure(runs: Dict[str, List[dict]], evals: Dict[str, List[di
         steps = [r["env_steps"] for r in records]
         last_step = max(last_step, steps[-1])
         w = max(1, len(records) // 50)
-        axes[0].plot(steps, _smooth([r["return"] for r in records], w), color=color[label], label=label)
-        axes[1].plot(steps, _smooth([float(r["success"]) for r in records], w), color=color[label], label=label)
+        axes[0].plot(steps, _smooth([r["return"] for r in records], w), color=color[label], label=_name(label))
+        axes[1].plot(steps, _smooth([float(r["success"]) for r in records], w), color=color[label], alpha=0.3,
+                     lw=1, label=f"{_name(label)}, training episodes")
+    for label, records in (evals or {}).items():
+        if records and "success_rate" in records[0]["summary"]:
+            axes[1].plot([r["env_steps"] for r in records], [r["summary"]["success_rate"] for r in records], "o-",
+                         color=color[label], ms=4, label=f"{_name(label)}, held-out")
     has_errors = _plot_heldout(axes[2], evals or {}, color)
     for label, summary in (baselines or {}).items():
-        axes[1].axhline(summary["success_rate"], color=color[label], ls="--", label=f"{label} held-out success")
+        axes[1].axhline(summary["success_rate"], color=color[label], ls="--", label=f"{_name(label)}, held-out")
         if has_errors:
             axes[2].axhline(summary["position_error_median"], color=color[label], ls="--",
-                            label=f"{label} held-out median")
+                            label=f"{_name(label)} held-out median")
     if has_errors:
         summaries = [r["summary"] for records in (evals or {}).values() for r in records]
         tolerance = _tolerances(summaries + list((baselines or {}).values()))[0]
@@ -117,15 +125,15 @@ def learning_curves_figure(runs: Dict[str, List[dict]], evals: Dict[str, List[di
         ax.legend(fontsize=8, loc="best")
     axes[0].set_title("(a) training episode return", fontsize=10)
     axes[0].set_ylabel("episode return")
-    axes[1].set_title("(b) training success rate (smoothed)", fontsize=10)
-    axes[1].set_ylabel("fraction of training episodes")
+    axes[1].set_title("(b) success: held-out targets (training episodes faded)", fontsize=10)
+    axes[1].set_ylabel("success rate")
     if has_errors:
         axes[2].set_title("(c) held-out final position error", fontsize=10)
         axes[2].set_ylabel("position error (m)")
     else:
         axes[2].set_title("(c) held-out evaluation return", fontsize=10)
         axes[2].set_ylabel("episode return")
-    fig.suptitle("Learning curves: " + " vs ".join(runs) + " (the curriculum's lessons between "
+    fig.suptitle("Learning curves: " + " vs ".join(map(_name, runs)) + " (the curriculum's lessons between "
                  "dashed lines)", fontsize=11)
     fig.tight_layout()
     return fig
@@ -141,12 +149,12 @@ def _plot_heldout(ax, evals: Dict[str, List[dict]], color) -> bool:
         if "position_error_median" not in records[0]["summary"]:
             has_errors = False
             ax.plot(steps, [r["summary"]["return_mean"] for r in records], "o-", color=color[label],
-                    label=f"{label} mean return")
+                    label=f"{_name(label)} mean return")
             continue
         ax.plot(steps, [r["summary"]["position_error_median"] for r in records], "o-", color=color[label],
-                label=f"{label} median")
+                label=f"{_name(label)} median")
         ax.plot(steps, [r["summary"]["position_error_p90"] for r in records], "x--", color=color[label],
-                label=f"{label} p90")
+                label=f"{_name(label)} p90")
     return has_errors
 
 
@@ -176,15 +184,15 @@ def _plot_targets_in_order(ax, report: dict) -> None:
                     fontsize=10, fontweight="bold")
 
 
-# How a figure names the runs of robostrich-train (its run directories' labels)
-RUN_NAMES = {"curriculum": "curriculum SAC", "baseline": "plain SAC (final lesson only)", "lookup": "lookup (no learning)"}
+def _name(label: str) -> str:
+    return RUN_NAMES.get(label, label)
 
 
 def _track_label(label: str, report: dict, note: str = None) -> str:
     """'curriculum SAC (seed 2, 600k control steps): 3 of 3 reached': the run against the goal."""
     segments = report.get("segments", [])
     reached = sum(bool(seg.get("success")) for seg in segments)
-    name = RUN_NAMES.get(label, label) + (f" ({note})" if note else "")
+    name = _name(label) + (f" ({note})" if note else "")
     return f"{name}: {reached} of {len(segments)} reached" if segments else name
 
 
