@@ -52,6 +52,20 @@ def rolling():
     plt.close(fig)
 
 
+def test_rolling_and_lever_share_one_figure_with_their_ratio_against_the_goal(rolling):
+    """The ratio is the point: both patterns on one attitude axis, the ratio and its goal in the title."""
+    run, _ = rolling
+    lever = movement.run(movement.MovementConfig("lever", ramp_time=0.25))
+    fig = movement_figure.comparison_figure({"rolling": run, "lever": lever})
+    try:
+        ratio = run.attitude_range() / lever.attitude_range()
+        assert f"rolling / lever at equal head travel: {ratio:.2f} (goal" in fig._suptitle.get_text()
+        labels = _legend_labels(fig.axes[0])
+        assert labels[0].startswith(f"rolling: range {run.attitude_range():.1f} deg") and labels[1].startswith("lever")
+    finally:
+        plt.close(fig)
+
+
 def test_movement_figure_has_panel_letters_and_a_time_colourbar(rolling):
     _, fig = rolling
     titles = _panel_titles(fig, 3)

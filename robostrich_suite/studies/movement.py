@@ -480,6 +480,7 @@ def run_patterns(args, base: MovementConfig, spec) -> tuple[dict, list]:
     if len(results) == 2:
         ratio = results["rolling"].attitude_range() / max(results["lever"].attitude_range(), 1e-9)
         print(f"attitude range rolling / lever: {ratio:.2f}")
+        written.append(movement_figure.plot_comparison(results, args.out / "rolling_vs_lever.png"))
     return results, written
 
 

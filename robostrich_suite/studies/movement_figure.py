@@ -111,3 +111,52 @@ def plot_movement(movement, path: str | pathlib.Path, num_sticks: int = 12
     files.save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path
+
+
+def comparison_figure(movements: dict):
+    """Rolling beside lever on one scale: (A) head attitude over time from the ramps' start, (B)
+    the head's paths; the title gives their attitude ranges, their ratio and the goal it is read
+    against (the paper's: rolling keeps the attitude steadier, a ratio below 1)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax_att, ax_path) = plt.subplots(1, 2, figsize=(12, 4.8))
+    colors = {"rolling": "tab:blue", "lever": "tab:orange"}
+    for pattern, movement in movements.items():
+        moving = movement.moving
+        summary = movement.summary()
+        label = (f"{pattern}: range {summary['attitude_range_deg']:.1f} deg, "
+                 f"head travel {1000 * summary['head_travel_m']:.0f} mm")
+        ax_att.plot(movement.time[moving] - movement.settle_time, movement.head_attitude[moving],
+                    color=colors.get(pattern), label=label)
+        path = 1000 * movement.head_position[moving]
+        ax_path.plot(path[:, 0], path[:, 1], color=colors.get(pattern), label=pattern)
+        ax_path.plot(*path[0], "o", color=colors.get(pattern), mfc="w")
+    ax_att.axhline(90, color="green", lw=0.8, ls=":", label="level head (90 deg)")
+    ax_att.set_xlabel("time since the ramps started (s)")
+    ax_att.set_ylabel("head attitude (deg, 90 = level)")
+    ax_att.set_title("(A) head attitude, both patterns on one scale", fontsize=10)
+    ax_path.set_xlabel("x (mm, forward)")
+    ax_path.set_ylabel("z (mm, up)")
+    ax_path.set_aspect("equal", "datalim")
+    ax_path.set_title("(B) head path (circle: start)", fontsize=10)
+    for ax in (ax_att, ax_path):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="best")
+    if {"rolling", "lever"} <= set(movements):
+        ratio = movements["rolling"].attitude_range() / max(movements["lever"].attitude_range(), 1e-9)
+        fig.suptitle(f"Attitude range rolling / lever at equal head travel: {ratio:.2f} (goal, the paper's "
+                     "Sec. 4.3: below 1, rolling keeps the head steadier)", fontsize=11)
+    fig.tight_layout()
+    return fig
+
+
+def plot_comparison(movements: dict, path: str | pathlib.Path) -> pathlib.Path:
+    """Write :func:`comparison_figure` to ``path`` (PNG)."""
+    import matplotlib.pyplot as plt
+    path = pathlib.Path(path)
+    fig = comparison_figure(movements)
+    files.save_figure(fig, path, dpi=120)
+    plt.close(fig)
+    return path
