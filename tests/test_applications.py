@@ -7,7 +7,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from agents.robostrich import application_commands, applications, gap, stabilization
+from agents.robostrich import application_commands, application_figures, applications, gap, stabilization
 from robostrich_suite.tasks import quadruped_tasks
 
 from conftest import console_script
@@ -44,6 +44,16 @@ def test_holding_the_lookup_input_stabilises_the_head_better_than_zero_input(ref
     assert 0 <= k["attitude_within_fraction"] <= 1 and k["distance_crests"] > 3
     goals = report["zero"]["goals"]
     assert set(goals) == set(stabilization.GOALS) and not any(g["met"] for g in goals.values())
+    # Fig. 9 reads each panel against its goal: every policy's worst seed, the goal, met or not
+    fig = application_figures.stabilization_figure(report)
+    try:
+        texts = [t.get_text() for ax in fig.axes for t in ax.get_legend().get_texts()]
+        height = goals["height_rms_error"]["worst"] * 100
+        assert f"head (zero): height {height:.1f} cm RMS off (goal <= 1 cm, not met)" in texts
+        assert any(t.startswith("lookup: level ") and "(goal >= 90 %" in t for t in texts), texts
+    finally:
+        import matplotlib.pyplot as plt
+        plt.close(fig)
 
 
 def test_narrow_gap_reports_every_sub_target_with_contact_forces_from_a_real_rollout(references):

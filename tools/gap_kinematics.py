@@ -123,15 +123,13 @@ def plot(head, neck, masks, pivot_point, rows, mount, path):
         for i in rng.choice(chosen, min(20, chosen.size), replace=False) if chosen.size else []:
             ax.plot(neck[i, :, 0], neck[i, :, 1], lw=0.8)
             ax.plot(*head[i], "k*", ms=5)
-        ax.set_title(f"{name}: {mask.sum()} level poses")
+        ax.set_title(f"{name}: {mask.sum()} level poses ({min(20, mask.sum())} drawn)")
     axes[1].plot(*pivot_point, "ro", ms=9, mfc="none", mew=2, label="pivot (poses agree to here)")
-    axes[1].legend(loc="lower left", fontsize=8)
     ax = axes[3]
     for row in rows:
         ax.plot(row["head_path"][:, 0], row["head_path"][:, 1], lw=0.8)
     ax.axhspan(*BARRIER_BAND, color="0.6", alpha=0.5, label="barrier height over the mount")
     ax.set_title("head paths: curled -> a raised pose's input (1 s ramp)")
-    ax.legend(loc="lower left", fontsize=8)
     for ax in axes:
         ax.plot(*mount, "ks", ms=6)
         ax.set_aspect("equal")
@@ -140,7 +138,13 @@ def plot(head, neck, masks, pivot_point, rows, mount, path):
     axes[0].set_ylabel("above ground (m)")
     axes[0].set_xlim(-0.6, 0.8)
     axes[0].set_ylim(0.1, 1.0)
-    fig.tight_layout()
+    key = [plt.Line2D([], [], color="C0", lw=0.8, label="a level pose's neck (one colour each)"),
+           plt.Line2D([], [], color="k", marker="*", ls="", label="its head"),
+           plt.Line2D([], [], color="k", marker="s", ls="", label="the arm's mount on the trunk"),
+           *axes[1].get_legend_handles_labels()[0], *axes[3].get_legend_handles_labels()[0],
+           plt.Line2D([], [], color="C1", lw=0.8, label="a head path (right)")]
+    fig.legend(handles=key, loc="lower center", ncol=len(key), fontsize=9, frameon=False)
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
     save_figure(fig, path, dpi=80)
     plt.close(fig)
 

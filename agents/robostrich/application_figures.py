@@ -45,10 +45,29 @@ def _height_changes(series) -> list:
     return spans
 
 
+# Panel of Fig. 9 -> the goal it is read against (stabilization.GOALS' metric) and how to say it
+_STABILIZATION_GOALS = {0: ("height_rms_error", "height {:.1f} cm RMS off", 100, "cm"),
+                        1: ("head_vz_rms_ratio", "velocity RMS {:.2f} of the trunk's", 1, ""),
+                        2: ("distance_mean_error", "P_d {:.1f} cm off", 100, "cm"),
+                        3: ("attitude_within_fraction", "level {:.0f} % of the time", 100, "%")}
+
+
+def _against_goal(report: dict, panel: int) -> str:
+    """'height 0.8 cm RMS off (goal <= 1.0 cm, met)': a policy's worst seed against a Fig. 9 goal."""
+    name, text, scale, unit = _STABILIZATION_GOALS[panel]
+    check = report.get("goals", {}).get(name)
+    if check is None:
+        return ""
+    bound = "<=" if check["kind"] == "max" else ">="
+    goal = f"{check['goal'] * scale:g}{' ' + unit if unit else ''}"
+    return f": {text.format(check['worst'] * scale)} (goal {bound} {goal}, {'met' if check['met'] else 'not met'})"
+
+
 def stabilization_figure(reports: dict, path: Optional[str] = None, settle: float = 0.0):
     """Fig. 9: (A) head and trunk z, (B) their z velocities, (C) head-trunk distance with P_d,
     (D) head attitude with the desired band; trunk-height ramps shaded grey, the unscored
-    first `settle` seconds hatched (B's scale ignores them: the arm's first fall is fast)."""
+    first `settle` seconds hatched (B's scale ignores them: the arm's first fall is fast).
+    Each policy's legend entry gives its worst seed's metric of that panel against its goal."""
     fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
     first = next(iter(reports.values()))["series"]
     for ax in axes:
@@ -58,11 +77,11 @@ def stabilization_figure(reports: dict, path: Optional[str] = None, settle: floa
             ax.axvspan(0, settle, facecolor="none", hatch="//", edgecolor="0.8", lw=0, zorder=0)
     for i, (label, report) in enumerate(reports.items()):
         s, color = report["series"], _color(label, i)
-        axes[0].plot(s["time"], s["head_z"], color=color, lw=1.2, label=f"head ({label})")
+        axes[0].plot(s["time"], s["head_z"], color=color, lw=1.2, label=f"head ({label}){_against_goal(report, 0)}")
         axes[0].plot(s["time"], s["trunk_z"], color=color, lw=0.8, ls="--", label=f"trunk ({label})")
-        axes[1].plot(s["time"], s["head_vz"], color=color, lw=1.0, label=f"head ({label})")
-        axes[2].plot(s["time"], s["distance"], color=color, lw=1.0, label=label)
-        axes[3].plot(s["time"], s["attitude"], color=color, lw=1.0, label=label)
+        axes[1].plot(s["time"], s["head_vz"], color=color, lw=1.0, label=f"head ({label}){_against_goal(report, 1)}")
+        axes[2].plot(s["time"], s["distance"], color=color, lw=1.0, label=f"{label}{_against_goal(report, 2)}")
+        axes[3].plot(s["time"], s["attitude"], color=color, lw=1.0, label=f"{label}{_against_goal(report, 3)}")
     axes[1].plot(first["time"], first["trunk_vz"], color="k", lw=0.6, alpha=0.6, label="trunk")
     scored = [np.abs(r["series"][key][np.asarray(r["series"]["time"]) >= settle])
               for r in reports.values() for key in ("head_vz", "trunk_vz")]
@@ -80,7 +99,7 @@ def stabilization_figure(reports: dict, path: Optional[str] = None, settle: floa
     for ax, title in zip(axes, titles):
         ax.set_ylabel(title, fontsize=8)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=6, ncol=3, loc="best")
+        ax.legend(fontsize=6, ncol=2, loc="best")
     axes[-1].set_xlabel("time (s); grey: trunk height changing; hatched: not scored")
     fig.suptitle("Head stabilisation while walking (Fig. 9)")
     fig.tight_layout()
