@@ -62,7 +62,7 @@ def _routing_panel(ax, spec: arm_lib.ArmSpec, layout: arm_lib.TendonLayout) -> N
         ax.plot(xs[-1], y, ">", color=colour, ms=5)
         if tendon.on_base:
             ax.plot(start, y, "s", color=colour, ms=4)
-        ax.text(xs[-1] + 0.012, y, tendon.name, va="center", fontsize=5.5, color=colour)
+        ax.text(xs[-1] + 0.012, y, tendon.name, va="center", fontsize=7, color=colour)
     top = max(lanes.values()) + 0.8
     ax.set_ylim(-lanes["ventral"] - 0.8, lanes["dorsal"] + 0.8 if lanes["dorsal"] else top)
     ax.set_xlim(anchor - 0.02, joints[-1] + 0.2)
@@ -77,8 +77,12 @@ def _routing_panel(ax, spec: arm_lib.ArmSpec, layout: arm_lib.TendonLayout) -> N
         ax.spines[spine].set_visible(False)
 
 
+MAX_COLUMNS = 4  # cases side by side; more wrap onto further rows (a figure readable at page width)
+
+
 def plot(cases, region: coverage_lib.BlueRegion, results, path) -> pathlib.Path:
-    """One column per case: blue region with held level poses (top), routing (bottom)."""
+    """Per case, blue region with held level poses over its routing; at most MAX_COLUMNS cases
+    side by side, more wrapping onto further rows."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -87,17 +91,21 @@ def plot(cases, region: coverage_lib.BlueRegion, results, path) -> pathlib.Path:
 
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    columns = len(cases)
-    fig, axes = plt.subplots(2, columns, figsize=(max(3.3 * columns, 10.0), 7.2), squeeze=False,
-                             gridspec_kw=dict(height_ratios=[2.2, 1.3]))
+    columns = min(len(cases), MAX_COLUMNS)
+    rows = -(-len(cases) // columns)
+    fig, axes = plt.subplots(2 * rows, columns, figsize=(max(3.4 * columns, 10.0), 5.0 * rows + 1.2),
+                             squeeze=False, gridspec_kw=dict(height_ratios=[2.2, 1.3] * rows))
+    for index in range(len(cases), rows * columns):  # an unfilled last row
+        axes[2 * (index // columns), index % columns].set_visible(False)
+        axes[2 * (index // columns) + 1, index % columns].set_visible(False)
     base_xz = workspace.base_joint_xz(scenes.frame_physics(cases[0].spec, cases[0].layout),
                                       cases[0].spec)
     everything = np.concatenate([region.head_position] + [r["held"] for r in results]
                                 + [base_xz[None]])
     low, high = everything.min(axis=0) - 0.03, everything.max(axis=0) + 0.03
-    for column, (case, result) in enumerate(zip(cases, results)):
-        row = result["row"]
-        ax = axes[0, column]
+    for index, (case, result) in enumerate(zip(cases, results)):
+        row, column = result["row"], index % columns
+        ax = axes[2 * (index // columns), column]
         _region_panel(ax, region, result["held"], result["covered"], base_xz)
         ax.set_xlim(low[0], high[0])
         ax.set_ylim(low[1], high[1])
@@ -105,11 +113,12 @@ def plot(cases, region: coverage_lib.BlueRegion, results, path) -> pathlib.Path:
         ax.grid(alpha=0.25)
         ax.set_title(f"{case.label} ({len(case.layout)} tendons)\ncoverage {row['coverage']:.0%} "
                      f"({row['covered_cells']}/{row['blue_cells']} cells), "
-                     f"{row['distinct_targets']} targets", fontsize=8.5)
-        ax.set_xlabel("x (m, forward)", fontsize=8)
-        ax.tick_params(labelsize=7)
-        _routing_panel(axes[1, column], case.spec, case.layout)
-    axes[0, 0].set_ylabel("z (m, up)", fontsize=8)
+                     f"{row['distinct_targets']} targets", fontsize=9.5)
+        ax.set_xlabel("x (m, forward)", fontsize=9)
+        ax.tick_params(labelsize=8)
+        if column == 0:
+            ax.set_ylabel("z (m, up)", fontsize=9)
+        _routing_panel(axes[2 * (index // columns) + 1, column], case.spec, case.layout)
     level = f"{conventions.LEVEL_ATTITUDE_DEG:g}$\\pm${conventions.LEVEL_TOLERANCE_DEG:g}$^\\circ$"
     handles = [
         Line2D([], [], ls="", marker="o", ms=3, color="tab:blue", label=f"kinematic head, attitude {level} (blue region)"),
@@ -124,11 +133,10 @@ def plot(cases, region: coverage_lib.BlueRegion, results, path) -> pathlib.Path:
         Line2D([], [], ls="", marker="s", ms=4, color="0.3", label="anchor on the base"),
         Line2D([], [], ls="", marker=">", ms=5, color="0.3", label="insertion (dots: holes passed)"),
     ]
-    fig.legend(handles=handles, loc="lower center", ncol=3 if columns < 3 else 5, fontsize=7.5,
-               frameon=False)
+    fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=8.5, frameon=False)
     fig.suptitle("Tendon layouts on the Table 1 links: blue region of Fig. 6 held level "
-                 "(top), routing on the straightened neck (bottom)", fontsize=10)
-    fig.tight_layout(rect=(0, 0.08, 1, 0.96))
-    files.save_figure(fig, path, dpi=140)
+                 "(above), routing on the straightened neck (below)", fontsize=11)
+    fig.tight_layout(rect=(0, 0.1 / rows, 1, 1 - 0.03 / rows))
+    files.save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
