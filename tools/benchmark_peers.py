@@ -22,10 +22,7 @@ import os
 import shlex
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # results_peers, also when imported
-
-from agents.robostrich import peers  # noqa: E402  (needs no sbx to import)
+from agents.robostrich import peers  # needs no sbx to import
 
 PROG = "benchmark_peers"
 AGENTS = ("curriculum", "plain", *peers.PEERS)

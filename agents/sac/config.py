@@ -62,7 +62,7 @@ class SACConfig:
     # original SAC code's mean regulariser, 1e-3 there; 0 = off, plain SAC). An action whose
     # mean sits deep in the tanh's saturation gets almost no gradient from the critic (at 2.9:
     # 1 - tanh^2 = 0.012); this pulls it back where the critic can move it
-    # (docs/log/learning.md#a-tendon-stuck-in-the-tanhs-saturation-a-penalty-on-the-pre-tanh-mean-2026-12-01).
+    # (docs/log/learning.md, the section of 2026-12-01 on a penalty on the pre-tanh mean).
     pre_tanh_penalty: float = 0.1
     # Evaluate (and deploy) an exponential moving average of the policy's parameters, updated
     # with this rate after every gradient step (0 = off: the last policy, as the paper). The
