@@ -195,7 +195,12 @@ def main(argv=None) -> dict:
     groups, runs = plan(args, passthrough)
     if args.address is not None:
         sweep_ray.check_reachable(args.address)
-    lock = directory_lock.lock_directory(args.out, PROG)  # noqa: F841  (held until this process ends)
+    with directory_lock.lock_directory(args.out, PROG):  # released, and its file removed, however this ends
+        return _sweep(args, argv, groups, runs)
+
+
+def _sweep(args, argv, groups, runs) -> dict:
+    """The sweep in its locked directory: run what is missing, write the table."""
     check_recorded_groups(args.out, groups)
     command = [PROG, *(sys.argv[1:] if argv is None else argv)]
     pending = [run for run in runs if not run.finished()]
