@@ -12,7 +12,7 @@ import pytest
 import robostrich_suite
 from robostrich_suite import scenes, targets
 from robostrich_suite.model import arm, layouts
-from robostrich_suite.studies import design, design_space, gap_column, gap_passage, layout_compare
+from robostrich_suite.studies import design, design_objectives, design_space, gap_column, gap_passage, layout_compare
 
 import results_page
 from conftest import console_script
@@ -72,6 +72,32 @@ def test_necks_swinging_as_a_lever_have_no_column_and_a_shelf_across_a_neck_touc
     rising = _rising_necks([0.24])
     assert not gap_column.Scene(0.29, 0.10).touches(rising.points, rising.radii)[0]  # through the slot
     assert gap_column.Scene(0.20, 0.10).touches(rising.points, rising.radii)[0]  # the shelf across the neck
+
+
+def test_a_slot_range_keeps_only_the_columns_whose_slot_lies_in_it():
+    held = _rising_necks([0.20, 0.24, 0.28])  # a column at x 0.30
+    inside = gap_column.tallest_column(held, lambda a, b, scene: True, slot_x=(0.2, 0.4))
+    assert inside.height == pytest.approx(0.08) and 0.2 <= inside.scene.slot_x <= 0.4
+    assert gap_column.threading(held, slot_x=(0.2, 0.4)).all()
+    assert abs(gap_column.refine_targets(held, 2, (0.2, 0.4))[0, 0] - 0.30) < 1e-9
+    assert gap_column.columns(held, slot_x=(-0.1, 0.1)) == []
+    assert gap_column.tallest_column(held, lambda a, b, scene: True, slot_x=(-0.1, 0.1)) == gap_column.NO_COLUMN
+    assert not gap_column.threading(held, slot_x=(-0.1, 0.1)).any()
+    assert gap_column.refine_targets(held, 2, (-0.1, 0.1)) is None
+    # Without a column the way in ramps into the highest level pose over the range, the slot under it.
+    target = design_objectives.passage_target(gap_column.NO_COLUMN, held, (0.2, 0.35))
+    assert target.poses == (2,) and target.scene.slot_x == pytest.approx(0.30) and target.height == 0.0
+    assert design_objectives.passage_target(gap_column.NO_COLUMN, held, (-0.1, 0.1)) == gap_column.NO_COLUMN
+
+
+def test_the_way_in_scores_the_height_reached_through_the_slot_and_the_column_when_it_gets_there():
+    score = design_objectives.passage_score
+    assert score({"highest_in_slot_m": -0.10, "clear": 0}, 0.08) == pytest.approx(-0.10)
+    assert score({"highest_in_slot_m": 0.03, "clear": 1}, 0.08) == pytest.approx(0.11)
+    never = score({"highest_in_slot_m": None, "clear": 0, "nearest_to_slot_m": 0.2}, 0.08)
+    assert never == pytest.approx(design_objectives.PASSAGE_FLOOR - 0.2)
+    assert never < score({"highest_in_slot_m": -0.5, "clear": 0}, 0.0)
+    assert score({"highest_in_slot_m": None, "clear": 0, "nearest_to_slot_m": None}, 0.0) < never
 
 
 def test_a_ramp_that_stays_still_is_clear_and_one_through_the_shelf_is_not():
@@ -140,6 +166,25 @@ def test_a_tiny_search_keeps_the_papers_routing_and_drops_the_one_from_the_base(
     page = results_page.render_record(record)
     assert f"| 1 | {rows[1]['coverage']:.0%} |" in page and "2 routings (1 with rolling/lever" in page
     assert "front of 1" in capsys.readouterr().out
+
+
+def test_a_search_scored_by_the_way_in_records_it_per_trial(tmp_path):
+    out = tmp_path / "out"
+    summary = design.main(["--trials", "1", "--out", str(out), "--start-from", "ventral_slips", "--slot-x", "0.2,0.5",
+                           "--score-passage", *TINY])
+    assert summary["gap_objective"] == "passage" and summary["slot_x"] == [0.2, 0.5]
+    assert summary["objectives"] == ["coverage", "gap_passage_m"]
+    (row,) = summary["front"]
+    passage = row["passage"]
+    assert passage["samples"] == design_objectives.PASSAGE_SAMPLES and passage["ramps"] > 0
+    height = row["gap_column_m"] if passage["target"] == "column" else 0.0
+    assert row["gap_passage_m"] == design_objectives.passage_score(passage, height)
+    assert summary["best_feasible_passage_m"] == row["gap_passage_m"]
+    gap = row["gap"]
+    assert gap["slot_x_m"] is None or 0.2 <= gap["slot_x_m"] <= 0.5
+    record = results_page.make_record("design", str(out / "design.json"), "Way in searched", date="2026-12-04")
+    page = results_page.render_record(record)
+    assert "scored by coverage and the way in" in page and "the slot 20 to 50 cm ahead" in page
 
 
 def test_the_space_round_trips_a_routing_and_refuses_one_outside_it():
@@ -221,6 +266,10 @@ def test_ctrl_c_marks_the_running_trial_failed_and_keeps_the_finished_ones(tmp_p
     (["--storage", "nosuchdialect://x"], "--storage nosuchdialect://x:"),
     (["--start-from", "antagonist_pairs"], "--start-from antagonist_pairs: the search's routings have 1 dorsal"),
     (["--start-from", "nosuchlayout"], "unknown layout 'nosuchlayout'"),
+    (["--slot-x", "0.5,0.2"], "--slot-x: MIN must be below MAX"),
+    (["--slot-x", "0.3"], "--slot-x: must be two numbers MIN,MAX"),
+    (["--slot-x", "0.1,nan"], "--slot-x: must be two numbers MIN,MAX"),
+    (["--slot-x=-2,0.1"], "--slot-x: must lie within -1 to 1 m"),
 ])
 def test_bad_input_is_one_line_and_exit_status_2(argv, message, tmp_path, capsys):
     assert _status([*argv, "--out", str(tmp_path / "out")]) == 2
@@ -241,3 +290,14 @@ def test_a_study_resumed_with_another_pose_budget_is_refused(tmp_path, capsys):
     assert design.cli(["--trials", "0", "--out", str(out), *TINY]) == 0
     assert design.cli(["--trials", "0", "--out", str(out), "--pose-budget", "7", "--quiet"]) == 2
     assert "was started with --pose-budget 6" in capsys.readouterr().err
+
+
+def test_a_study_resumed_with_another_slot_range_or_scoring_is_refused(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert design.cli(["--trials", "0", "--out", str(out), "--slot-x", "0.2,0.5", *TINY]) == 0
+    assert design.cli(["--trials", "0", "--out", str(out), "--slot-x", "0.2,0.5", *TINY]) == 0
+    for other in (["--slot-x=-0.1,0.1"], [], ["--slot-x", "0.2,0.5", "--score-passage"]):
+        capsys.readouterr()
+        assert design.cli(["--trials", "0", "--out", str(out), *other, *TINY]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "was started with --pose-budget 6 --slot-x 0.2,0.5:" in err

@@ -17,6 +17,19 @@ def read(data: dict, path: str, group: str = None) -> tuple:
     return data, data.get("command")
 
 
+def scoring(data: dict) -> str:
+    """Which second objective the study used, and where its slot was held (records before the flags
+    existed: the column, the slot anywhere, and nothing said)."""
+    if "gap_objective" not in data:
+        return ""
+    slot = data.get("slot_x")
+    where = "anywhere" if slot is None else f"{100 * slot[0]:.0f} to {100 * slot[1]:.0f} cm ahead of the base joint"
+    what = ("the way in from under the shelf (how far up through the slot the head gets; best feasible "
+            f"{100 * data['best_feasible_passage_m']:+.1f} cm from the shelf's top)"
+            if data["gap_objective"] == "passage" else "the gap column")
+    return f"; scored by coverage and {what}, the slot {where}"
+
+
 def caption(data: dict) -> str:
     trials, need = data["trials"], data["need"]
     rate = (f", {trials['trials_per_core_hour']:g} trials per hour of one core ({trials['trials_per_hour']:g} "
@@ -24,7 +37,7 @@ def caption(data: dict) -> str:
     return (f"{trials['complete']} routings ({trials['feasible']} with rolling/lever <= {data['ratio_limit']:g}) at "
             f"{data['pose_budget']} sought poses each{rate}; best gap column "
             f"{100 * data['best_feasible_gap_column_m']:.1f} cm ({100 * data['best_gap_column_m']:.1f} cm of any routing), "
-            f"the narrow gap needs {100 * need['column_height_m']:.0f} cm above its shelf")
+            f"the narrow gap needs {100 * need['column_height_m']:.0f} cm above its shelf{scoring(data)}")
 
 
 def _percent(value) -> str:
@@ -50,18 +63,26 @@ def _passage(row: dict) -> str:
     return f"{passage['clear']} of {passage['ramps']} ramps clear; {where}"
 
 
+def _way_in(row: dict) -> str:
+    passage = row.get("passage") or {}
+    return f"{100 * row['gap_passage_m']:+.1f} cm ({_passage(row)}; into: {passage.get('target') or 'nothing'})"
+
+
 def short(data: dict) -> list:
     """The front (cheap scores, with the full measures where a routing has them), then every routing
     confirmed, on the front now or not."""
     confirmed = {row["trial"]: row for row in data.get("confirmed", [])}
-    lines = ["| trial | coverage (sampled cells) | gap column | rolling / lever | confirmed coverage | "
-             "confirmed gap column | confirmed rolling / lever |", "|---|---|---|---|---|---|---|"]
+    passage = data.get("gap_objective") == "passage"
+    lines = ["| trial | coverage (sampled cells) | gap column | " + ("way in (cheap) | " if passage else "")
+             + "rolling / lever | confirmed coverage | confirmed gap column | confirmed rolling / lever |",
+             "|---|---|---|---|---|---|---|" + ("---|" if passage else "")]
     for row in data["front"]:
         check = confirmed.get(row["trial"])
         later = ([_percent(check["coverage"]), _column(check), f"{check['rolling_lever_ratio']:.2f}"] if check
                  else ["-", "-", "-"])
         lines.append(f"| {row['trial']} | {_percent(row['coverage'])} | {_column(row)} | "
-                     f"{row['rolling_lever_ratio']:.2f} | " + " | ".join(later) + " |")
+                     + (f"{_way_in(row)} | " if passage else "")
+                     + f"{row['rolling_lever_ratio']:.2f} | " + " | ".join(later) + " |")
     if confirmed:
         lines += ["", "Confirmed (robostrich-layouts' measures, every blue cell; the gap column at the full budget):", "",
                   "| trial | coverage | distinct level targets | gap column | rolling / lever | "

@@ -15,6 +15,21 @@ test the paper's arm passes, not a quantity to trade, so it bounds the search in
 spreading the front over a third axis; coverage and the gap column do trade (a neck that rises
 under its head reaches less of the region in front), and the front shows how.
 
+**The slot where the task puts it, and the way in** (2026-12-04, docs/layouts.md).  The first
+search found its columns over the mount, and no ramp from under the shelf got into any of them.
+``--slot-x MIN,MAX`` holds the slot's centre in that range (m ahead of the base joint; the task's
+is ``gap_column.TASK_NEED["slot_x_m"]``, 0.36 m); ``--score-passage`` replaces the second objective
+by the way in (``design_objectives.passage_score``): how far up through the slot the head gets
+from under the shelf before anything touches (m from the shelf's top), plus the column's height
+when a ramp reaches the column; a head never over the slot scores the floor (the ground) less how
+far in x it stayed from the slot.  A column nobody can enter is worth nothing to the task, and a
+pass/fail count would be 0 for every routing the first search found: the height is graded, so the
+sampler can climb towards a way in before any exists.  The ramps go into the column's lowest pose;
+with no column in the range, into the highest held pose whose head is over the range (level ones
+first, the slot under it); with none, the floor less 1 m.  It costs 100 draws and 6 ramps a trial
+(``design_objectives.PASSAGE_SAMPLES``), about a quarter of a trial.  Both flags are fixed for a
+study, as ``--pose-budget`` is; a negative MIN is written ``--slot-x=-0.1,0.1``.
+
 **Multi-objective TPE** (Optuna's ``TPESampler`` with ``constraints_func``; ``constant_liar`` so
 that several machines on one ``--storage`` do not all try the same routing): with a few hundred
 trials of ~10 s it is the more sample-efficient choice; NSGA-II needs generations of a population
@@ -45,11 +60,35 @@ from robostrich_suite import outputs
 PROG = "robostrich-design"
 RATIO_LIMIT = 0.6  # rolling / lever attitude ratio a routing must not pass (module doc)
 OBJECTIVES = ("coverage", "gap_column_m")  # both maximised
+PASSAGE_OBJECTIVES = ("coverage", "gap_passage_m")  # with --score-passage
+SLOT_X_LIMIT = 1.0  # m: --slot-x within this of the base joint
 MAX_TRIALS = 100_000
 MAX_POSE_BUDGET = 2_000
 MIN_POSE_BUDGET = 6  # two coverage cells, three column targets, one to grow a column
 HEARTBEAT_S, GRACE_S = 30, 120  # a trial silent this long was on a machine that died: failed
 FRONT_LAYOUTS = 10  # the front's routings written as layout files, best gap column first
+
+
+def objectives(score_passage: bool) -> tuple:
+    return PASSAGE_OBJECTIVES if score_passage else OBJECTIVES
+
+
+def slot_range(text: str) -> tuple:
+    """argparse type for --slot-x: 'MIN,MAX', finite, MIN < MAX, within +-SLOT_X_LIMIT m."""
+    import argparse
+    import math
+    parts = text.split(",")
+    try:
+        low, high = (float(part) for part in parts) if len(parts) == 2 else (math.nan, math.nan)
+    except ValueError:
+        low = high = math.nan
+    if not (math.isfinite(low) and math.isfinite(high)):
+        raise argparse.ArgumentTypeError(f"must be two numbers MIN,MAX (m), got {text!r}")
+    if not low < high:
+        raise argparse.ArgumentTypeError(f"MIN must be below MAX, got {text}")
+    if max(abs(low), abs(high)) > SLOT_X_LIMIT:
+        raise argparse.ArgumentTypeError(f"must lie within -{SLOT_X_LIMIT:g} to {SLOT_X_LIMIT:g} m, got {text}")
+    return low, high
 
 
 def build_parser() -> cli_lib.Parser:
@@ -69,6 +108,12 @@ def build_parser() -> cli_lib.Parser:
                         help="sought poses per trial, fixed for a study (default: %(default)s)")
     parser.add_argument("--search-stiffness", action="store_true",
                         help="search the passive joint stiffness too (0.5-4 N m/rad), fixed for a study")
+    parser.add_argument("--slot-x", type=slot_range, default=None, metavar="MIN,MAX",
+                        help="the gap's slot centred within MIN..MAX m ahead of the base joint, fixed for a study "
+                             "(default: anywhere; the task's slot is at 0.36)")
+    parser.add_argument("--score-passage", action="store_true",
+                        help="score the way into the gap from under the shelf instead of the column's height, "
+                             "fixed for a study (module doc)")
     parser.add_argument("--start-from", nargs="+", default=[], metavar="LAYOUT",
                         help="built-in layouts or layout files tried first, when the study is new "
                              "(each must be in the space: 1 dorsal + 8 ventral tendons through every link; default: none)")
@@ -86,12 +131,12 @@ def main(argv=None) -> dict:
     outputs.check_directory(args.out)
     args.out.mkdir(parents=True, exist_ok=True)
     storage_url = args.storage or f"sqlite:///{(args.out / 'study.db').resolve()}"
-    study = design_study.open_study(storage_url, args.study_name, args.pose_budget, args.search_stiffness, args.seed)
+    settings = design_study.Settings(args.pose_budget, args.search_stiffness, args.slot_x, args.score_passage)
+    study = design_study.open_study(storage_url, args.study_name, settings, args.seed)
     command = shlex.join([PROG, *(sys.argv[1:] if argv is None else argv)])
     with cli_lib.deferred_interrupts():
         design_study.enqueue_once(study, starts, args.search_stiffness)
-        design_study.run_trials(study, args.trials, args.pose_budget, args.search_stiffness,
-                                show_progress=not args.quiet)
+        design_study.run_trials(study, args.trials, settings, show_progress=not args.quiet)
         if cli_lib.interrupted():
             raise KeyboardInterrupt
     # Outside the deferral: Ctrl-C stops a confirmation at once; each routing's measures are kept as it ends.

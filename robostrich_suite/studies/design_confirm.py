@@ -10,9 +10,9 @@ from robostrich_suite.studies import design_objectives, design_space, gap_column
 from robostrich_suite import cli as cli_lib
 
 
-def confirm(trials, out: pathlib.Path, show_progress: bool = True):
+def confirm(trials, out: pathlib.Path, show_progress: bool = True, slot_x=None):
     """Yields per trial, as each is measured: coverage of every blue cell (random and sought poses), distinct targets, the
-    movement tests at full bisection, and the gap column with the full pose budget."""
+    movement tests at full bisection, and the gap column with the full pose budget (slot within ``slot_x``)."""
     from tqdm import tqdm
     full = design_objectives.FULL
     for trial in tqdm(trials, desc="confirming", unit="routing", disable=not show_progress):
@@ -26,15 +26,16 @@ def confirm(trials, out: pathlib.Path, show_progress: bool = True):
             raise KeyboardInterrupt
         yield {"trial": trial.number, **{k: measured[k] for k in (
             "coverage", "covered_cells", "blue_cells", "level_poses", "distinct_targets", "rolling_lever_ratio",
-            "rolling_range_deg", "lever_range_deg", "head_travel_mm", "target_file")}, **gap_measures(trial)}
+            "rolling_range_deg", "lever_range_deg", "head_travel_mm", "target_file")}, **gap_measures(trial, slot_x)}
 
 
-def gap_measures(trial) -> dict:
-    """The gap column of ``trial``'s routing at the full budget, and the passage into it."""
+def gap_measures(trial, slot_x=None) -> dict:
+    """The gap column of ``trial``'s routing at the full budget (slot within ``slot_x``), and the
+    passage into it."""
     full = design_objectives.FULL
     spec, layout = design_space.spec(trial.params), design_space.layout(trial.params)
     cells, coarse, refine = full.split()
     column, held = gap_column.measure(spec, layout, coarse + cells, refine, full.seek_time, full.hold_time,
-                                      full.max_ramps, cli_lib.interrupted)
+                                      full.max_ramps, cli_lib.interrupted, slot_x)
     passage = gap_passage.measure(spec, layout, column, held, full.hold_time, interrupted=cli_lib.interrupted)
     return {"gap_column_m": column.height, "gap": column.summary(held), "passage": passage}

@@ -6,7 +6,10 @@
   ``robostrich-layouts``), estimated on a fixed, spread subset of the cells with one sought pose
   each: every routing gets the same cells, so trials compare;
 * **gap column**: the height of the tallest column of level poses through a 7 cm slot
-  (:mod:`robostrich_suite.studies.gap_column`).
+  (:mod:`robostrich_suite.studies.gap_column`);
+* **way in** (``--score-passage``): how far up through the slot the head gets from under the
+  shelf (:mod:`robostrich_suite.studies.gap_passage` at :data:`PASSAGE_SAMPLES` draws and
+  ``PASSAGE_STARTS`` x 2 ramps), :func:`passage_score`.
 
 :class:`Budget` sizes the cheap score of a search trial; :data:`FULL` is the confirmation's.
 """
@@ -17,8 +20,9 @@ import time
 
 import numpy as np
 
+from robostrich_suite import scenes
 from robostrich_suite.studies import coverage as coverage_lib
-from robostrich_suite.studies import gap_column, layout_compare, pose_seek, workspace
+from robostrich_suite.studies import gap_column, gap_passage, layout_compare, pose_seek, workspace
 
 KINEMATIC_SAMPLES = layout_compare.DEFAULT_KINEMATIC_SAMPLES  # the blue region robostrich-layouts uses
 
@@ -40,6 +44,12 @@ class Budget:
         refine = gap // 3
         return cells, gap - refine, refine
 
+
+PASSAGE_SAMPLES = 100  # inputs drawn for the poses under the shelf, per trial (confirmation: gap_passage's 600)
+PASSAGE_STARTS = 3  # of them ramped into the target, each quick and slow: 6 ramps
+# The score of a way in that never brings the head over the slot: the ground, relative to the shelf's
+# top (no head over the slot is lower), less how far in x from the slot's edge it stayed (at most 1 m).
+PASSAGE_FLOOR = -round(gap_column.SHELF_Z + scenes.GAP_SHELF_THICKNESS + scenes.NOMINAL_MOUNT_HEIGHT, 4)
 
 FULL = Budget(poses=180, seek_time=pose_seek.SEEK_TIME, movement_iterations=7, max_ramps=200)
 
@@ -82,19 +92,63 @@ def movement(spec, layout, budget: Budget) -> dict:
     return layout_compare.movement_ratio(case, budget.movement_iterations)
 
 
-def evaluate(spec, layout, budget: Budget = Budget(), interrupted=lambda: False) -> dict:
+def passage_target(column: gap_column.Column, held: gap_column.HeldPoses, slot_x=None) -> gap_column.Column:
+    """What the way in ramps into: the column's lowest pose; without a column, the highest held pose
+    whose head is over the slot range (within ``gap_column.COLUMN_TOLERANCE``), level ones first, the
+    slot under it; :data:`gap_column.NO_COLUMN` when there is none."""
+    if column.scene is not None and column.poses:
+        return column
+    low, high = (-np.inf, np.inf) if slot_x is None else slot_x
+    x = held.head[:, 0]
+    over = np.flatnonzero(held.settled & (x >= low - gap_column.COLUMN_TOLERANCE)
+                          & (x <= high + gap_column.COLUMN_TOLERANCE))
+    if not len(over):
+        return gap_column.NO_COLUMN
+    top = int(max(over, key=lambda i: (bool(held.level()[i]), held.head[i, 1])))
+    return gap_column.Column(gap_column.Scene(float(np.clip(x[top], low, high)), gap_column.SHELF_Z), (top,), 0.0)
+
+
+def passage_score(passage: dict, column_height: float) -> float:
+    """How far up through the slot the head got from under the shelf (m from the shelf's top), with
+    the column's height added when a ramp reached it; never over the slot: :data:`PASSAGE_FLOOR` less
+    the nearest it came to the slot in x.  Graded everywhere, so the sampler learns even when no way
+    in passes."""
+    if passage["highest_in_slot_m"] is not None:
+        return round(passage["highest_in_slot_m"] + (column_height if passage["clear"] else 0.0), 4)
+    nearest = passage.get("nearest_to_slot_m")
+    return round(PASSAGE_FLOOR - min(1.0 if nearest is None else nearest, 1.0), 4)
+
+
+def way_in(spec, layout, column, held, budget: Budget, slot_x=None, interrupted=lambda: False) -> dict:
+    """The cheap way in (:func:`passage_target`, :func:`passage_score`) as the trial's result keys."""
+    target = passage_target(column, held, slot_x)
+    passage = gap_passage.measure(spec, layout, target, held, budget.hold_time, PASSAGE_SAMPLES, PASSAGE_STARTS,
+                                  interrupted)
+    passage["target"] = ("column" if target is column and column.poses else None if not target.poses else
+                         "highest level pose over the slot" if held.level()[target.poses[0]] else
+                         "highest pose over the slot (none level)")
+    return {"passage": passage, "gap_passage_m": passage_score(passage, target.height)}
+
+
+def evaluate(spec, layout, budget: Budget = Budget(), interrupted=lambda: False, slot_x=None,
+             score_passage: bool = False) -> dict:
     """Every objective of one routing, with what it cost (``interrupted()`` polled between poses:
-    True raises KeyboardInterrupt)."""
+    True raises KeyboardInterrupt); the gap's slot within ``slot_x`` (None: anywhere); with
+    ``score_passage`` the way in too (:func:`way_in`)."""
     start, cpu = time.perf_counter(), time.process_time()
     cells, coarse, refine = budget.split()
     result = movement(spec, layout, budget)
     result.update(coverage(spec, layout, cells, budget, interrupted))
     column, held = gap_column.measure(spec, layout, coarse, refine, budget.seek_time, budget.hold_time,
-                                      budget.max_ramps, interrupted)
+                                      budget.max_ramps, interrupted, slot_x)
     result["gap"] = column.summary(held)
     result["gap_column_m"] = result["gap"]["column_height_m"]
     result["gap_level_poses"] = int(held.level().sum())
-    result["gap_threading_poses"] = int(gap_column.threading(held).sum())
+    result["gap_threading_poses"] = int(gap_column.threading(held, slot_x=slot_x).sum())
+    if score_passage:
+        passage_start = time.perf_counter()
+        result.update(way_in(spec, layout, column, held, budget, slot_x, interrupted))
+        result["passage"]["seconds"] = round(time.perf_counter() - passage_start, 2)
     result["seconds"] = round(time.perf_counter() - start, 2)
     result["cpu_seconds"] = round(time.process_time() - cpu, 2)
     return result

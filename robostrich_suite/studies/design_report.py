@@ -11,7 +11,7 @@ import statistics
 
 from robostrich_suite import files
 from robostrich_suite.model import layouts as layouts_lib
-from robostrich_suite.studies import design_space, design_study, gap_column
+from robostrich_suite.studies import design_objectives, design_space, design_study, gap_column
 
 
 def trial_row(trial, layout_file: str | None = None) -> dict:
@@ -20,6 +20,8 @@ def trial_row(trial, layout_file: str | None = None) -> dict:
            "cells": result.get("cells"), "gap_column_m": result.get("gap_column_m"),
            "rolling_lever_ratio": result.get("rolling_lever_ratio"), "gap": result.get("gap"),
            "gap_threading_poses": result.get("gap_threading_poses"), "seconds": result.get("seconds")}
+    if "gap_passage_m" in result:  # --score-passage: the way in, the trial's second objective
+        row.update(gap_passage_m=result["gap_passage_m"], passage=result.get("passage"))
     if "stiffness" in trial.params:
         row["joint_stiffness"] = round(trial.params["stiffness"], 4)
     if layout_file:
@@ -60,18 +62,27 @@ def summary(study, command: str, storage_url: str, layout_files: dict, confirmed
     front = design_study.pareto_front(study)
     states = [t.state for t in study.get_trials(deepcopy=False)]
     best = max((t.user_attrs.get("result", {}).get("gap_column_m") or 0.0 for t in complete), default=0.0)
-    best_feasible = max((t.values[1] for t in complete if design_study.feasible(t)), default=0.0)
+    best_feasible = max((t.user_attrs["result"]["gap_column_m"] for t in complete if design_study.feasible(t)),
+                        default=0.0)
+    settings = design_study.Settings.of(study)
+    passage = {}
+    if settings.score_passage:
+        passage["best_feasible_passage_m"] = max(
+            (t.values[1] for t in complete if design_study.feasible(t)), default=design_objectives.PASSAGE_FLOOR - 1.0)
     return {
         "benchmark": "design", "command": command, "study": study.study_name,
         "storage": design_study.redacted(storage_url),
         "pose_budget": study.user_attrs.get("pose_budget"),
         "search_stiffness": study.user_attrs.get("search_stiffness"),
-        "sampler": "multi-objective TPE with constraints (Optuna)", "objectives": list(design.OBJECTIVES),
+        "slot_x": None if settings.slot_x is None else list(settings.slot_x),
+        "gap_objective": "passage" if settings.score_passage else "column",
+        "sampler": "multi-objective TPE with constraints (Optuna)",
+        "objectives": list(design.objectives(settings.score_passage)),
         "ratio_limit": design.RATIO_LIMIT,
         "trials": {"complete": len(complete), "feasible": sum(map(design_study.feasible, complete)),
                    "failed": states.count(optuna.trial.TrialState.FAIL),
                    "running": states.count(optuna.trial.TrialState.RUNNING), **rate(complete)},
-        "best_gap_column_m": best, "best_feasible_gap_column_m": best_feasible,
+        "best_gap_column_m": best, "best_feasible_gap_column_m": best_feasible, **passage,
         "need": gap_column.TASK_NEED,
         "front": [trial_row(t, layout_files.get(t.number)) for t in front],
         "confirmed": confirmed,
@@ -103,10 +114,14 @@ def plot(study, front, path: pathlib.Path) -> pathlib.Path:
         for t in front[:10]:
             ax.annotate(str(t.number), (t.values[0], 100 * t.values[1]), fontsize=7, xytext=(4, 4),
                         textcoords="offset points")
-    ax.axhline(100 * gap_column.TASK_NEED["column_height_m"], color="k", ls="--", lw=0.8,
-               label="column the narrow gap needs above the shelf")
+    if design_study.Settings.of(study).score_passage:
+        ax.axhline(0.0, color="k", ls="--", lw=0.8, label="the shelf's top")
+        ax.set_ylabel("way in: head's height through the slot (cm from the shelf's top)")
+    else:
+        ax.axhline(100 * gap_column.TASK_NEED["column_height_m"], color="k", ls="--", lw=0.8,
+                   label="column the narrow gap needs above the shelf")
+        ax.set_ylabel("gap column height (cm)")
     ax.set_xlabel("coverage of the blue region's sampled cells (held level)")
-    ax.set_ylabel("gap column height (cm)")
     ax.set_title(f"{study.study_name}: {len(trials)} routings, pose budget {study.user_attrs.get('pose_budget')}")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
@@ -138,8 +153,10 @@ def print_summary(result: dict, out: pathlib.Path) -> None:
     print(f"{trials['complete']} complete trials ({trials['feasible']} feasible, {trials['failed']} failed)"
           f"{rate_text}; front of {len(result['front'])}")
     for row in result["front"][:10]:
-        print(f"  trial {row['trial']}: coverage {row['coverage']:.0%}, gap column {100 * row['gap_column_m']:.1f} cm, "
-              f"rolling/lever {row['rolling_lever_ratio']:.2f}")
+        way_in = (f", way in {100 * row['gap_passage_m']:+.1f} cm from the shelf's top" if "gap_passage_m" in row
+                  else "")
+        print(f"  trial {row['trial']}: coverage {row['coverage']:.0%}, gap column {100 * row['gap_column_m']:.1f} cm"
+              f"{way_in}, rolling/lever {row['rolling_lever_ratio']:.2f}")
     need = result["need"]["column_height_m"]
     print(f"best gap column {100 * result['best_feasible_gap_column_m']:.1f} cm with rolling/lever <= "
           f"{result['ratio_limit']:g}, {100 * result['best_gap_column_m']:.1f} cm of any routing (the narrow gap needs "

@@ -1,13 +1,15 @@
 """The Optuna study behind ``robostrich-design``: opening or resuming it, its trials, the front.
 
-A study is fixed to one pose budget and one choice of searching the stiffness (its user
-attributes): trials scored at different budgets do not compare, so resuming with others is refused.
+A study is fixed to its :class:`Settings` (pose budget, searching the stiffness, the slot's range,
+scoring the way in; its user attributes): trials scored otherwise do not compare, so resuming
+with others is refused.
 Each trial stores its measures as the user attribute ``result`` and the constraint
 (rolling/lever ratio minus ``design.RATIO_LIMIT``, feasible at <= 0) as the user attribute
 ``constraint`` and as Optuna's own constraint, which the sampler reads.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import pathlib
 
@@ -16,6 +18,32 @@ from robostrich_suite.model import layouts as layouts_lib
 from robostrich_suite.studies import design_objectives, design_space
 
 MAX_RATIO = 1e3  # a routing whose lever hardly turns the head: the ratio is "huge", kept finite
+
+
+@dataclasses.dataclass(frozen=True)
+class Settings:
+    """What a study's trials are scored with, fixed when it starts (robostrich-design's flags)."""
+    pose_budget: int = 36
+    search_stiffness: bool = False
+    slot_x: tuple | None = None  # (min, max) m of the slot's centre; None: anywhere
+    score_passage: bool = False
+
+    def attrs(self) -> dict:
+        return {"pose_budget": self.pose_budget, "search_stiffness": self.search_stiffness,
+                "slot_x": None if self.slot_x is None else list(self.slot_x), "score_passage": self.score_passage}
+
+    @classmethod
+    def of(cls, study) -> "Settings":
+        """The settings ``study`` was started with (one started before a flag existed: its default)."""
+        attrs = study.user_attrs
+        slot_x = attrs.get("slot_x")
+        return cls(attrs.get("pose_budget", cls.pose_budget), bool(attrs.get("search_stiffness")),
+                   None if slot_x is None else tuple(slot_x), bool(attrs.get("score_passage")))
+
+    def flags(self) -> str:
+        return (f"--pose-budget {self.pose_budget}" + (" --search-stiffness" if self.search_stiffness else "")
+                + (f" --slot-x {self.slot_x[0]:g},{self.slot_x[1]:g}" if self.slot_x is not None else "")
+                + (" --score-passage" if self.score_passage else ""))
 
 
 def _optuna():
@@ -30,9 +58,9 @@ def sampler(seed: int):
     return optuna.samplers.TPESampler(seed=seed, constant_liar=True)
 
 
-def open_study(url: str, name: str, pose_budget: int, stiffness: bool, seed: int):
+def open_study(url: str, name: str, settings: Settings, seed: int):
     """The study ``name`` in ``url``, made if new; ValueError (one line) for a bad URL or a study
-    of another budget.  The sampler's seed is offset by the trials it holds, so a resumed study
+    of other :class:`Settings`.  The sampler's seed is offset by the trials it holds, so a resumed study
     does not draw its first routings again."""
     optuna = _optuna()
     from robostrich_suite.studies import design
@@ -47,13 +75,11 @@ def open_study(url: str, name: str, pose_budget: int, stiffness: bool, seed: int
                                 directions=["maximize"] * len(design.OBJECTIVES))
     if list(study.directions) != [optuna.study.StudyDirection.MAXIMIZE] * len(design.OBJECTIVES):
         raise ValueError(f"study {name!r} in {redacted(url)} is not a robostrich-design study")
-    attrs = study.user_attrs
-    if not attrs:
-        study.set_user_attr("pose_budget", pose_budget)
-        study.set_user_attr("search_stiffness", stiffness)
-    elif (attrs.get("pose_budget"), attrs.get("search_stiffness")) != (pose_budget, stiffness):
-        raise ValueError(f"study {name!r} was started with --pose-budget {attrs.get('pose_budget')}"
-                         f"{' --search-stiffness' if attrs.get('search_stiffness') else ''}: resume it with the "
+    if not study.user_attrs:
+        for key, value in settings.attrs().items():
+            study.set_user_attr(key, value)
+    elif Settings.of(study) != settings:
+        raise ValueError(f"study {name!r} was started with {Settings.of(study).flags()}: resume it with the "
                          "same, or give another --study-name")
     study.sampler = sampler(seed + len(study.trials))
     return study
@@ -96,32 +122,33 @@ def complete_trials(study) -> list:
     return study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
 
 
-def objective(pose_budget: int, stiffness: bool):
+def objective(settings: Settings):
     from robostrich_suite.studies import design
-    budget = design_objectives.Budget(poses=pose_budget)
+    budget = design_objectives.Budget(poses=settings.pose_budget)
 
     def score(trial):
-        params = design_space.suggest(trial, stiffness)
+        params = design_space.suggest(trial, settings.search_stiffness)
         result = design_objectives.evaluate(design_space.spec(params), design_space.layout(params), budget,
-                                            interrupted=cli_lib.interrupted)
+                                            cli_lib.interrupted, settings.slot_x, settings.score_passage)
         ratio = result["rolling_lever_ratio"]
         ratio = MAX_RATIO if ratio is None or not math.isfinite(ratio) else min(ratio, MAX_RATIO)
         result["rolling_lever_ratio"] = ratio
         trial.set_user_attr("result", result)
         trial.set_user_attr("constraint", ratio - design.RATIO_LIMIT)
         trial.set_constraint("rolling_lever_ratio", ratio - design.RATIO_LIMIT)
-        return tuple(result[name] for name in design.OBJECTIVES)
+        return tuple(result[name] for name in design.objectives(settings.score_passage))
     return score
 
 
-def run_trials(study, trials: int, pose_budget: int, stiffness: bool, show_progress: bool = True) -> None:
+def run_trials(study, trials: int, settings: Settings, show_progress: bool = True) -> None:
     """Trials until the study holds ``trials`` complete ones; Ctrl-C (polled between poses) fails the
     running trial and stops (the caller raises it)."""
     from tqdm import tqdm
     done = len(complete_trials(study))
     if done >= trials:
         return
-    score = objective(pose_budget, stiffness)
+    score = objective(settings)
+    what = "way in" if settings.score_passage else "column"
     with tqdm(total=trials, initial=done, desc="routings", unit="trial", disable=not show_progress,
               mininterval=1.0) as bar:
         while done < trials and not cli_lib.interrupted():
@@ -135,7 +162,7 @@ def run_trials(study, trials: int, pose_budget: int, stiffness: bool, show_progr
             front = pareto_front(study)
             if front:
                 best = max(front, key=lambda t: (t.values[1], t.values[0]))
-                bar.set_postfix_str(f"front {len(front)}, best column {100 * best.values[1]:.1f} cm")
+                bar.set_postfix_str(f"front {len(front)}, best {what} {100 * best.values[1]:.1f} cm")
 
 
 def feasible(trial) -> bool:
@@ -172,9 +199,11 @@ def confirm(study, count: int, out: pathlib.Path, show_progress: bool = True) ->
     from robostrich_suite.studies import design_confirm
     done = {row["trial"]: row for row in confirmed(study)}
     todo = [t for t in pareto_front(study)[:count] if t.number not in done]
-    for row in design_confirm.confirm(todo, out, show_progress):
+    slot_x = Settings.of(study).slot_x
+    for row in design_confirm.confirm(todo, out, show_progress, slot_x):
         study.set_user_attr(f"{CONFIRMED}{row['trial']}", row)
     for number, row in done.items():  # confirmed before the passage was measured: only that is added
         if "passage" not in row:
-            study.set_user_attr(f"{CONFIRMED}{number}", {**row, **design_confirm.gap_measures(study.trials[number])})
+            study.set_user_attr(f"{CONFIRMED}{number}",
+                                {**row, **design_confirm.gap_measures(study.trials[number], slot_x)})
     return confirmed(study)

@@ -20,7 +20,9 @@ this module finds the best place for such a shelf and measures the column it all
   height, and ``connected(a, b, scene)`` must hold for each pair: in simulation
   (:func:`ramp_stays_clear`) the inputs ramped from one to the other keep every capsule clear of
   the scene and end at the other pose;
-* the **column height** is the head-height range of the tallest such run, over every slot position.
+* the **column height** is the head-height range of the tallest such run, over every slot position,
+  or over those of a range ``slot_x`` = (min, max) (``robostrich-design --slot-x``: the slot held
+  where the task puts it, :data:`TASK_NEED`'s ``slot_x_m``).
 
 It is measured on the arm on its frame, in the base joint's frame: the standing quadruped holds
 the mount still, so its poses are the frame's moved by ``quadruped_tasks.FRAME_TO_TRUNK_OFFSET``
@@ -149,21 +151,32 @@ def capsule_radii(physics, geoms) -> np.ndarray:
     return np.repeat(np.asarray(physics.model.geom_size)[geoms, 0], SAMPLES_PER_CAPSULE)
 
 
-def columns(held: HeldPoses, shelf_z: float | None = None) -> list:
+def slot_positions(heads_x: np.ndarray, slot_x=None) -> np.ndarray:
+    """The slot centres tried for heads at ``heads_x``: every :data:`GRID` step near them, within
+    ``slot_x`` = (min, max) when given (None: anywhere)."""
+    grid = np.arange(np.floor((heads_x.min() - COLUMN_TOLERANCE) / GRID) * GRID,
+                     heads_x.max() + COLUMN_TOLERANCE + GRID, GRID)
+    if slot_x is None:
+        return grid
+    low, high = slot_x
+    return grid[(grid >= low - 1e-9) & (grid <= high + 1e-9)]
+
+
+def columns(held: HeldPoses, shelf_z: float | None = None, slot_x=None) -> list:
     """Every slot position's runs of poses in its column (module doc), tallest first, unverified;
-    the shelf's underside at ``shelf_z`` (default :data:`SHELF_Z`)."""
+    the shelf's underside at ``shelf_z`` (default :data:`SHELF_Z`), the slot's centre within
+    ``slot_x`` = (min, max) (None: anywhere)."""
     shelf_z = SHELF_Z if shelf_z is None else shelf_z
     level = np.flatnonzero(held.level() & (held.head[:, 1] > shelf_z + scenes.GAP_SHELF_THICKNESS))
     if len(level) < 1:
         return []
     scenes_of = {}
     head = held.head[level]
-    for slot_x in np.arange(np.floor((head[:, 0].min() - COLUMN_TOLERANCE) / GRID) * GRID,
-                            head[:, 0].max() + COLUMN_TOLERANCE + GRID, GRID):
-        near = level[np.abs(head[:, 0] - slot_x) <= COLUMN_TOLERANCE]
+    for centre in slot_positions(head[:, 0], slot_x):
+        near = level[np.abs(head[:, 0] - centre) <= COLUMN_TOLERANCE]
         if not len(near):
             continue
-        scene = Scene(float(slot_x), float(shelf_z))
+        scene = Scene(float(centre), float(shelf_z))
         clear = near[~scene.touches(held.points[near], held.radii)]
         order = clear[np.argsort(held.head[clear, 1])]
         for run in np.split(order, np.flatnonzero(np.diff(held.head[order, 1]) > MAX_STEP) + 1):
@@ -176,10 +189,11 @@ def columns(held: HeldPoses, shelf_z: float | None = None) -> list:
     return found
 
 
-def tallest_column(held: HeldPoses, connected, max_ramps: int = MAX_RAMPS) -> Column:
-    """The tallest column whose neighbouring poses are ``connected(a, b, scene)``, checking at
-    most ``max_ramps`` pairs (a pair that fails splits its run, and the parts compete again)."""
-    candidates = columns(held)
+def tallest_column(held: HeldPoses, connected, max_ramps: int = MAX_RAMPS, slot_x=None) -> Column:
+    """The tallest column (slot centre within ``slot_x``, None: anywhere) whose neighbouring poses
+    are ``connected(a, b, scene)``, checking at most ``max_ramps`` pairs (a pair that fails splits
+    its run, and the parts compete again)."""
+    candidates = columns(held, slot_x=slot_x)
     if not candidates:
         return NO_COLUMN
     checked, best = {}, Column(candidates[0].scene, candidates[0].poses[:1], 0.0)
@@ -243,10 +257,10 @@ START_LIBRARY = (40_000, 40_000)
 REFINE_STEP = 0.04  # m between the heads sought above and below a column found
 
 
-def threading(held: HeldPoses, shelf_z: float | None = None) -> np.ndarray:
-    """(n,) bool: poses in the column of some slot position (module doc), each on its own."""
+def threading(held: HeldPoses, shelf_z: float | None = None, slot_x=None) -> np.ndarray:
+    """(n,) bool: poses in the column of some slot position (within ``slot_x``), each on its own."""
     mask = np.zeros(len(held.head), bool)
-    for column in columns(held, shelf_z):
+    for column in columns(held, shelf_z, slot_x):
         mask[list(column.poses)] = True
     return mask
 
@@ -254,12 +268,25 @@ def threading(held: HeldPoses, shelf_z: float | None = None) -> np.ndarray:
 _library = {}
 
 
-def start_library(spec):
-    """(heads, joint angles) of the level kinematic poses of ``spec``'s links that thread a slot,
-    heads in the base joint frame (computed once per process)."""
+def over_slots(held: HeldPoses, slot_x, shelf_z: float | None = None) -> np.ndarray:
+    """(n,) bool: level poses with heads above the shelf's top and over ``slot_x`` = (min, max)
+    (within :data:`COLUMN_TOLERANCE`), whatever their necks touch."""
+    shelf_z = SHELF_Z if shelf_z is None else shelf_z
+    x = held.head[:, 0]
+    return (held.level() & (held.head[:, 1] > shelf_z + scenes.GAP_SHELF_THICKNESS)
+            & (x >= slot_x[0] - COLUMN_TOLERANCE) & (x <= slot_x[1] + COLUMN_TOLERANCE))
+
+
+def start_library(spec, slot_x=None):
+    """(heads, joint angles) of the level kinematic poses of ``spec``'s links that thread a slot
+    (its centre within ``slot_x``, None: anywhere), heads in the base joint frame (computed once per
+    process and range).  When none threads a slot in the range (the links' uniform and edge samples
+    hold none 0.2-0.5 m ahead), the level poses with heads above the shelf over the range: the
+    search still seeks there, and the way in (``design_objectives.passage_target``) has a target."""
     import mujoco
     from robostrich_suite.studies import workspace
-    key = (spec.joint_names, spec.link_lengths, spec.dorsal_limits_deg, spec.ventral_limits_deg, spec.head_length)
+    key = (spec.joint_names, spec.link_lengths, spec.dorsal_limits_deg, spec.ventral_limits_deg, spec.head_length,
+           None if slot_x is None else tuple(slot_x))
     if key not in _library:
         uniform, edge = START_LIBRARY
         samples = workspace.kinematic_samples(uniform, 0, spec, num_edge=edge)
@@ -274,7 +301,9 @@ def start_library(spec):
             points[k] = capsule_points(physics, geoms, lambda p: np.asarray(p)[[0, 2]] - base)
         held = HeldPoses(np.zeros((len(level), 0)), samples.head_position[level] - base, samples.head_attitude[level],
                          np.ones(len(level), bool), points, capsule_radii(physics, geoms))
-        keep = threading(held)
+        keep = threading(held, slot_x=slot_x)
+        if slot_x is not None and not keep.any():
+            keep = over_slots(held, slot_x)
         _library[key] = (held.head[keep], samples.joint_angles[level][keep])
     return _library[key]
 
@@ -308,10 +337,10 @@ def spread(heads: np.ndarray, count: int) -> np.ndarray:
     return np.array(chosen)
 
 
-def refine_targets(held: HeldPoses, count: int):
-    """(targets, None) that would grow the tallest column of ``held``: heads sought above and
-    below it at its x, alternately; None without a column."""
-    found = columns(held)
+def refine_targets(held: HeldPoses, count: int, slot_x=None):
+    """Targets that would grow the tallest column of ``held`` (slot within ``slot_x``): heads sought
+    above and below it at its x, alternately; None without a column."""
+    found = columns(held, slot_x=slot_x)
     if not found:
         return None
     heads = held.head[list(found[0].poses)]
@@ -322,11 +351,11 @@ def refine_targets(held: HeldPoses, count: int):
 
 
 def measure(spec, layout, coarse_count: int, refine_count: int, seek_time: float, hold_time: float,
-            max_ramps: int = MAX_RAMPS, interrupted=lambda: False) -> tuple[Column, HeldPoses]:
-    """The tallest column (module doc) among poses sought at ``coarse_count`` spread heads of
-    :func:`start_library` (each from its own kinematic pose's tendon lengths), then at
-    ``refine_count`` more that would grow the tallest column found (:func:`refine_targets`; without
-    one, at further library heads); the poses too."""
+            max_ramps: int = MAX_RAMPS, interrupted=lambda: False, slot_x=None) -> tuple[Column, HeldPoses]:
+    """The tallest column (module doc; the slot's centre within ``slot_x``, None: anywhere) among
+    poses sought at ``coarse_count`` spread heads of :func:`start_library` (each from its own
+    kinematic pose's tendon lengths), then at ``refine_count`` more that would grow the tallest
+    column found (:func:`refine_targets`; without one, at further library heads); the poses too."""
     from robostrich_suite.studies import pose_seek, workspace
     physics = scenes.frame_physics(spec, layout)
     base = workspace.base_joint_xz(physics, spec)
@@ -334,7 +363,7 @@ def measure(spec, layout, coarse_count: int, refine_count: int, seek_time: float
     def to_plane(point):
         return np.asarray(point)[[0, 2]] - base
 
-    heads, angles = start_library(spec)
+    heads, angles = start_library(spec, slot_x)
     order = spread(heads, coarse_count + refine_count)
 
     def seek(targets, starts):
@@ -349,7 +378,7 @@ def measure(spec, layout, coarse_count: int, refine_count: int, seek_time: float
     first = order[:coarse_count]
     held = hold_poses(physics, seek(heads[first], angles[first]), to_plane, hold_time, interrupted)
     if refine_count:
-        targets = refine_targets(held, refine_count)
+        targets = refine_targets(held, refine_count, slot_x)
         if targets is None:
             rest = order[coarse_count:]
             targets, starts = heads[rest], angles[rest]
@@ -364,4 +393,4 @@ def measure(spec, layout, coarse_count: int, refine_count: int, seek_time: float
             raise KeyboardInterrupt
         return ramp_stays_clear(physics, held, a, b, scene, to_plane, hold_time)
 
-    return tallest_column(held, connected, max_ramps), held
+    return tallest_column(held, connected, max_ramps, slot_x), held

@@ -14,7 +14,7 @@ after the other, which a neck bending as a whole may not manage.  This module me
   ends at that pose;
 * **how far up through the slot** a ramp got: the highest its head came, over the slot and
   before anything touched, relative to the shelf's top (negative: still under the shelf; none: the
-  head was never over the slot).
+  head was never over the slot), and how near in x to the slot's edge it came when never over it.
 
 Straight ramps between held inputs are one family of ways up, not all: a passage found is a way,
 none found is evidence, not proof.
@@ -42,7 +42,8 @@ def measure(spec, layout, column: gap_column.Column, held: gap_column.HeldPoses,
             samples: int = UNDER_SAMPLES, ramps: int = RAMPS, interrupted=lambda: False) -> dict:
     """The passage into ``column`` (of ``held``, :func:`gap_column.measure` of the routing): module doc."""
     if column.scene is None or not column.poses:
-        return {"under_poses": 0, "samples": 0, "ramps": 0, "clear": 0, "highest_in_slot_m": None}
+        return {"under_poses": 0, "samples": 0, "ramps": 0, "clear": 0, "highest_in_slot_m": None,
+                "nearest_to_slot_m": None}
     physics = scenes.frame_physics(spec, layout)
     base = workspace.base_joint_xz(physics, spec)
 
@@ -57,7 +58,7 @@ def measure(spec, layout, column: gap_column.Column, held: gap_column.HeldPoses,
     starts = starts[np.argsort(np.abs(under.head[starts, 0] - scene.slot_x))][:ramps]
     shelf_top = scene.shelf_z + scenes.GAP_SHELF_THICKNESS
     half = scenes.GAP_SLOT_WIDTH / 2
-    clear, highest = 0, -np.inf
+    clear, highest, nearest = 0, -np.inf, np.inf
     for i in starts:
         for ramp_time in RAMP_TIMES:
             if interrupted():
@@ -66,8 +67,11 @@ def measure(spec, layout, column: gap_column.Column, held: gap_column.HeldPoses,
             arrived = ok and np.linalg.norm(heads[-1] - held.head[column.poses[0]]) <= gap_column.ARRIVAL
             clear += int(arrived)
             over_slot = heads[np.abs(heads[:, 0] - scene.slot_x) <= half]
+            if len(heads):
+                nearest = min(nearest, float(np.abs(heads[:, 0] - scene.slot_x).min()) - half)
             if len(over_slot):
                 highest = max(highest, float(over_slot[:, 1].max()) - shelf_top)
     return {"under_poses": int(under_shelf(under, scene).sum()), "samples": samples,
             "ramps": len(starts) * len(RAMP_TIMES), "clear": clear,
-            "highest_in_slot_m": None if not np.isfinite(highest) else round(highest, 4)}
+            "highest_in_slot_m": None if not np.isfinite(highest) else round(highest, 4),
+            "nearest_to_slot_m": None if not np.isfinite(nearest) else round(max(nearest, 0.0), 4)}
