@@ -110,7 +110,7 @@ def build_parser() -> cli_lib.Parser:
                         help="search the passive joint stiffness too (0.5-4 N m/rad), fixed for a study")
     parser.add_argument("--slot-x", type=slot_range, default=None, metavar="MIN,MAX",
                         help="the gap's slot centred within MIN..MAX m ahead of the base joint, fixed for a study "
-                             "(default: anywhere; the task's slot is at 0.36)")
+                             "(default: anywhere; the task's slot is at 0.36; a negative MIN: --slot-x=-0.1,0.1)")
     parser.add_argument("--score-passage", action="store_true",
                         help="score the way into the gap from under the shelf instead of the column's height, "
                              "fixed for a study (module doc)")
