@@ -85,7 +85,7 @@ def test_the_command_writes_its_record_figure_and_table(tmp_path):
     common = ["--steps", "120", "--seeds", "0", "--ways", "final", "--eval-every", "60", "--record-only"]
     assert benchmark_peers.cli(common + ["--agents", "plain,tqc,sac", "--out", str(out)]) == 0
     data = json.loads((out / "peers.json").read_text())
-    assert set(data["runs"]) == {"plain", "tqc_final"} and data["unfinished"] == ["SBX SAC, final lesson only"]
+    assert set(data["runs"]) == {"plain", "tqc_final"} and data["unfinished"] == ["SBX SAC, final lesson only seed 0"]
     assert benchmark_peers.cli(common + ["--out", str(tmp_path / "empty")]) == 2
 
 

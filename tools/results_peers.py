@@ -17,7 +17,7 @@ def read(data: dict, path: str, group: str = None) -> tuple:
 def caption(data: dict) -> str:
     versions = ", ".join(f"{k} {v}" for k, v in data.get("versions", {}).items())
     ways = "; ".join(f"{way}: {plan}" for way, plan in data.get("ways", {}).items())
-    unfinished = f" ({', '.join(data['unfinished'])}: not finished)" if data.get("unfinished") else ""
+    unfinished = f" (not finished: {'; '.join(data['unfinished'])})" if data.get("unfinished") else ""
     return (f"{data['steps']} control steps per run, mean [min, max] over seeds {', '.join(map(str, data['seeds']))}"
             f"{unfinished}; "
             f"peers with their published defaults ({versions}); lessons as run ({ways}); steps to "
@@ -28,6 +28,12 @@ def caption(data: dict) -> str:
 def _reach(run: dict) -> str:
     return f"{run['reach_bar'] // 1000}k" if run["reach_bar"] is not None and run["reach_bar"] % 1000 == 0 \
         else str(run["reach_bar"] or "not reached")
+
+
+def _partial(run: dict, data: dict) -> str:
+    """' (seed 0 of 0, 1)' for a run finished on fewer seeds than the command's, else ''."""
+    seeds = run.get("seeds", data["seeds"])
+    return f" (seed {', '.join(map(str, seeds))} of seeds {', '.join(map(str, data['seeds']))})" if seeds != data["seeds"] else ""
 
 
 def _lookup_row(data: dict, kinds: list, detail: bool) -> str:
@@ -54,7 +60,7 @@ def short(data: dict) -> list:
                   f"{fixed['position_error_median']['mean'] * 100:.2f} cm, "
                   f"{fixed['attitude_error_median']['mean']:.2f} deg"] if fixed else ["-", "-"]
         cells += [_reach(run), cell(run["minutes"], 1, "min")]
-        lines.append(f"| {run['name']} | " + " | ".join(cells) + " |")
+        lines.append(f"| {run['name']}{_partial(run, data)} | " + " | ".join(cells) + " |")
     return lines + [_lookup_row(data, kinds, detail=True)]
 
 
@@ -64,6 +70,6 @@ def full(data: dict) -> list:
     for run in data["runs"].values():
         values = run["final"].get("heldout", {}).get("success_rate", {}).get("values", [])
         seeds = ", ".join(f"seed {s}: {v * 100:.1f} %" if v is not None else f"seed {s}: -"
-                          for s, v in zip(data["seeds"], values))
+                          for s, v in zip(run.get("seeds", data["seeds"]), values))
         lines.append(f"- {run['name']}: held-out from the fixed start {seeds}")
     return lines

@@ -40,9 +40,10 @@ def aggregate(settings, results: dict) -> dict:
     """{label: the run's record entry}: finals per evaluation, wall-clock and curve, over the seeds."""
     runs = {}
     for label in finished(settings, results):
-        rows = [results[(label, seed)] for seed in settings.seeds]
+        seeds = [seed for seed in settings.seeds if results.get((label, seed))]
+        rows = [results[(label, seed)] for seed in seeds]
         runs[label] = {
-            "name": run_name(label),
+            "name": run_name(label), "seeds": seeds,
             "final": {kind: {field: stats([row["final"].get(kind, {}).get(field) for row in rows])
                              for field in bench.FIELDS}
                       for kind in bench.KINDS if any(kind in row["final"] for row in rows)},
@@ -55,9 +56,10 @@ def aggregate(settings, results: dict) -> dict:
 
 
 def finished(settings, results: dict) -> list:
-    """The runs every seed of which has finished (a record from a stopped command holds only these)."""
+    """The runs with a finished seed (a record from a stopped command holds only these, each
+    over its finished seeds)."""
     return [label for label in bench.job_labels(settings)
-            if all(results.get((label, seed)) for seed in settings.seeds)]
+            if any(results.get((label, seed)) for seed in settings.seeds)]
 
 
 def lookup(settings, results: dict) -> dict:
@@ -76,8 +78,8 @@ def record(settings, results: dict, command: str) -> dict:
             "bar": bench.BAR, "num_eval_targets": settings.num_eval_targets, "versions": peers.versions(),
             "ways": {way: describe_way(way, settings.steps) for way in settings.ways},
             "runs": aggregate(settings, results), "lookup": lookup(settings, results),
-            "unfinished": [run_name(label) for label in bench.job_labels(settings)
-                           if label not in finished(settings, results)]}
+            "unfinished": [f"{run_name(label)} seed {seed}" for label in bench.job_labels(settings)
+                           for seed in settings.seeds if not results.get((label, seed))]}
 
 
 def describe_way(way: str, steps: int) -> str:
