@@ -215,6 +215,17 @@ def test_torn_and_damaged_metrics_lines(tmp_path):
         read_records(str(path))
 
 
+def test_a_torn_evaluation_report_is_named(tmp_path):
+    """A worker's report that a crash left in part is a ValueError naming the file, not a bare JSON error."""
+    from agents.robostrich.evaluation import read_reports
+    (tmp_path / "curriculum_heldout.json").write_text('{"summary": {"success_rate": 1.0}}')
+    (tmp_path / "curriculum_track.json").write_text('{"summary": {"succ')
+    with pytest.raises(ValueError, match=r"curriculum_track\.json"):
+        read_reports(str(tmp_path), "curriculum")
+    (tmp_path / "curriculum_track.json").unlink()
+    assert read_reports(str(tmp_path), "curriculum") == {"heldout": {"summary": {"success_rate": 1.0}}}
+
+
 def test_sigterm_is_handled_as_ctrl_c_checkpoint_written_and_143(tmp_path):
     """A batch scheduler stops a job with SIGTERM: training writes its checkpoint and exits 143 with one line."""
     out = tmp_path / "run"

@@ -18,7 +18,7 @@ from typing import Optional
 
 import numpy as np
 
-from robostrich_suite import files, outputs, web_viewer
+from robostrich_suite import files, outputs, parsing, web_viewer
 from agents.robostrich import probes
 from agents.robostrich.runs import make_environment
 from agents.robostrich.domains import MOVING_START_TASK, TRACK_TASK, as_domain
@@ -307,8 +307,7 @@ def read_reports(out_dir: str, label: str) -> dict:
     for kind in ("heldout", "heldout_moving", "track"):
         path = os.path.join(out_dir, f"{label}_{kind}.json")
         if os.path.exists(path):
-            with open(path) as f:
-                reports[kind] = json.load(f)
+            reports[kind] = parsing.read_json(path)  # a torn file is one ValueError naming it
     return reports
 
 
