@@ -5,11 +5,9 @@ import json
 ROW_NOISE = ("layout_file", "target_file")  # where one run wrote its files: not a result
 
 
-def read(data: dict, path: str, group: str = None) -> tuple:
+def read(data: dict, path: str) -> tuple:
     if "front" not in data or "trials" not in data or "need" not in data:
         raise ValueError(f"{path} is not robostrich-design's design.json (no 'front'/'trials'/'need')")
-    if group is not None:
-        raise ValueError(f"--group {group}: {path} is not a sweep")
     data = json.loads(json.dumps(data))
     for row in data["front"] + data.get("confirmed", []):
         for key in ROW_NOISE:

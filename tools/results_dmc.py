@@ -3,12 +3,10 @@ returns (tools/benchmark_dmc.py's dmc.json)."""
 import shlex
 
 
-def read(data: dict, path: str, group: str = None) -> tuple:
+def read(data: dict, path: str) -> tuple:
     """(data, the command it records or None); rows of (task, seed, evaluation point) are required."""
     if not data.get("rows"):
         raise ValueError(f"{path} holds no evaluation of tools/benchmark_dmc.py (no 'rows')")
-    if group is not None:
-        raise ValueError(f"--group {group}: {path} is not a sweep")
     command = data.get("command")
     return data, (shlex.join(command) if isinstance(command, list) else command)
 

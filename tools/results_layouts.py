@@ -5,11 +5,9 @@ import json
 ROW_NOISE = ("target_file",)  # where one run wrote its files: not a result
 
 
-def read(data: dict, path: str, group: str = None) -> tuple:
+def read(data: dict, path: str) -> tuple:
     if not data.get("rows") or "blue_region" not in data:
         raise ValueError(f"{path} is not robostrich-layouts' layouts.json (no 'rows'/'blue_region')")
-    if group is not None:
-        raise ValueError(f"--group {group}: {path} is not a sweep")
     data = json.loads(json.dumps(data))
     for row in data["rows"]:
         for key in ROW_NOISE:

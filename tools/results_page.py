@@ -95,9 +95,11 @@ def make_record(name: str, path: str, title: str, command: str = None, date: str
         raise ValueError(f"{path}: a JSON {type(written).__name__}, not the object a benchmark writes")
     kind = kind_of(written)
     try:
-        data, recorded = KINDS[kind].read(written, path, group)
+        data, recorded = KINDS[kind].read(written, path, group) if kind == "seeds" else KINDS[kind].read(written, path)
     except SHAPE_ERRORS as error:
         raise _named(error, path, f"not the {kind} file this tool records") from None
+    if group is not None and kind != "seeds":  # only a sweep has groups
+        raise ValueError(f"--group {group}: {path} is not a sweep")
     command = command or recorded
     if not command:
         raise ValueError(f"{path} records no command: give --command")

@@ -5,12 +5,10 @@ from results_seeds import cell
 KINDS = {"heldout": "held-out, fixed start", "heldout_moving": "moving starts", "track": "`track`"}
 
 
-def read(data: dict, path: str, group: str = None) -> tuple:
+def read(data: dict, path: str) -> tuple:
     """(data, the command it records); runs and seeds are required."""
     if not data.get("runs") or not data.get("seeds"):
         raise ValueError(f"{path} holds no run of tools/benchmark_peers.py (no 'runs' or 'seeds')")
-    if group is not None:
-        raise ValueError(f"--group {group}: {path} is not a sweep")
     return data, data.get("command")
 
 

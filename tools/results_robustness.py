@@ -5,11 +5,9 @@ robostrich_suite/tasks/perturbations.py)."""
 KINDS = {"heldout": "fixed start", "heldout_moving": "moving starts"}
 
 
-def read(data: dict, path: str, group: str = None) -> tuple:
+def read(data: dict, path: str) -> tuple:
     if not data.get("results") or not data.get("scales"):
         raise ValueError(f"{path} is not robostrich-robustness's robustness.json (no 'results')")
-    if group is not None:
-        raise ValueError(f"--group {group}: {path} is not a sweep")
     return data, data.get("command")
 
 

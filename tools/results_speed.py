@@ -2,11 +2,9 @@
 measured in the same run (tools/benchmark_env.py, benchmark_a1.py, benchmark_learner.py --json)."""
 
 
-def read(data: dict, path: str, group: str = None) -> tuple:
+def read(data: dict, path: str) -> tuple:
     if not data.get("ratios"):
         raise ValueError(f"{path} is not a speed benchmark's --json output (no 'ratios')")
-    if group is not None:
-        raise ValueError(f"--group {group}: {path} is not a sweep")
     return data, data.get("command")
 
 
