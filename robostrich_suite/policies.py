@@ -77,6 +77,11 @@ class Policy:
         observation = getattr(timestep_or_observation, "observation", timestep_or_observation)
         return self.select_action(self.flatten(observation))
 
+    def task_kwargs(self) -> dict:
+        """The task options this policy's observation needs (``observe_sent_actions``), {} for most."""
+        sent = self.info.get("observe_sent_actions")
+        return {"observe_sent_actions": int(sent)} if sent else {}
+
     def check(self, env) -> None:
         """PolicyMismatch (one line) unless ``env`` is the robot this policy was trained on,
         observes what it reads and takes the actions it gives."""
@@ -88,8 +93,9 @@ class Policy:
         observed = {key: int(np.prod(spec.shape)) for key, spec in env.observation_spec().items()}
         wrong = [key for key, size in self.observation_layout if observed.get(key) != size]
         if wrong:  # a task may observe more (track: its target index) than the policy reads
+            hint = (f"; load the task with task_kwargs={self.task_kwargs()}" if self.task_kwargs() else "")
             raise PolicyMismatch(f"this policy reads {wrong}, which the environment does not observe "
-                                 f"with the same sizes ({observed})")
+                                 f"with the same sizes ({observed}){hint}")
         spec = env.action_spec()
         if not (np.allclose(spec.minimum, self.action_low) and np.allclose(spec.maximum, self.action_high)):
             raise PolicyMismatch("the environment's action bounds differ from the policy's")

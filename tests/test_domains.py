@@ -63,9 +63,23 @@ def test_bad_domain_layout_and_task_names_are_errors_that_name_them():
         Domain("robostrich").check_task("lesson9")
     with pytest.raises(ValueError, match="unknown domain 'robostrch'.*robostrich"):
         Domain("robostrch").check_task("lesson1")
+    with pytest.raises(ValueError, match="observe_sent_actions applies to the arm domains.*'reacher'"):
+        Domain("reacher", sent_actions=3)
+    with pytest.raises(ValueError, match="observe_sent_actions must be a whole number.*from 0 to 8"):
+        Domain("robostrich", sent_actions=9)
     Domain("robostrich_a1").check_task("lesson4")
     Domain("reacher").check_task("easy")
     assert Domain("reacher").heldout_targets() is None and Domain("reacher").lookup_table() is None
+
+
+def test_a_domain_that_observes_its_sent_actions_gives_every_environment_that_observation():
+    observing = Domain("robostrich", sent_actions=2)
+    for task in ("lesson2", "lesson3", "track"):
+        observation = observing.make_environment(task, 0).reset().observation
+        assert observation["sent_actions"].shape == (18,), task
+    assert "sent_actions" not in Domain("robostrich").make_environment("lesson2", 0).reset().observation
+    assert observing.describe() == "robostrich (layout ventral_slips), observing 2 sent actions"
+    assert observing.info() == {"domain": "robostrich", "layout": "ventral_slips", "observe_sent_actions": 2}
 
 
 def test_curriculum_runs_every_lesson_on_the_quadruped_and_carries_the_learner(tmp_path):

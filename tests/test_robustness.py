@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import robostrich_suite
+from robostrich_suite import policies
 from agents import checkpoint
 from agents.curriculum import TrainingInterrupted
 from agents.robostrich import training
@@ -95,6 +96,42 @@ def test_latency_delays_every_action_by_exactly_its_steps(scale, steps):
     np.testing.assert_array_equal(arrived[:steps], 0.0)  # the input held when the episode began
 
 
+def test_the_observed_sent_actions_are_those_on_their_way_to_the_servos():
+    """With ``vary`` each fresh episode draws 0-3 steps of latency; the observation holds the last 3
+    actions sent (clipped, newest first), and the servos hold the one sent ``latency`` steps ago."""
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs={
+        "random": 3, "observe_sent_actions": 3, "perturbation": {"latency": 0.5, "vary": True}})
+    low, high = env.action_spec().minimum, env.action_spec().maximum
+    drawn = set()
+    for episode in range(16):
+        timestep = env.reset()
+        held = env.physics.arm_control().copy()
+        np.testing.assert_array_equal(timestep.observation["sent_actions"], np.tile(held, 3))
+        latency = env.task.randomizer._latency
+        drawn.add(latency)
+        sent = [np.random.RandomState(episode * 10 + i).uniform(low - 0.01, high) for i in range(5)]
+        for action in sent:
+            timestep = env.step(action)
+        clipped = np.clip(sent, low, high)
+        np.testing.assert_array_equal(timestep.observation["sent_actions"].reshape(3, 9), clipped[::-1][:3])
+        np.testing.assert_array_equal(env.physics.arm_control(), clipped[-1 - latency])
+    assert drawn == {0, 1, 2, 3}
+    assert "sent_actions" not in _env().reset().observation  # the default observation is unchanged
+
+
+def test_vary_draws_each_familys_scale_up_to_its_own():
+    env = _env(Perturbation(mass=0.4, joint_noise=0.4, vary=True))
+    scales = []
+    for _ in range(30):
+        env.reset()
+        drawn = env.task.randomizer.apply(env.physics, env.task.random)
+        scales.append([drawn["scale"]["mass"], drawn["scale"]["joint_noise"]])
+        assert np.all(np.abs(drawn["mass"] - 1) <= drawn["scale"]["mass"])
+    scales = np.array(scales)
+    assert scales.min() >= 0 and scales.max() <= 0.4 and scales.std(axis=0).min() > 0.05
+    assert abs(np.corrcoef(scales.T)[0, 1]) < 0.6  # each family from its own stream
+
+
 def test_the_quadruped_families_move_the_trunk_and_the_gait_clock():
     standing = _env(domain="robostrich_a1")
     higher = _env(Perturbation(trunk_height=0.5), domain="robostrich_a1")
@@ -115,8 +152,10 @@ def test_a_bad_scale_names_the_family():
 
 
 def test_randomised_training_runs_and_resumes_bit_for_bit(tmp_path):
-    """Every arm family at once, a checkpoint mid-episode (delayed actions pending), restored."""
-    task_kwargs = {"perturbation": {family: 0.3 for family in perturbations.ARM_FAMILIES}}
+    """Every arm family at once, drawn per episode, a checkpoint mid-episode (delayed actions
+    pending, the sent ones observed), restored."""
+    task_kwargs = {"perturbation": {**{family: 0.3 for family in perturbations.ARM_FAMILIES}, "latency": 0.5,
+                                    "vary": True}, "observe_sent_actions": 3}
     plan = parse_plan("robostrich/lesson3:320")
     config = dataclasses.replace(TINY, min_replay_size=100)
     a = DomainRun(plan, config, seed=2, run_dir=str(tmp_path / "a"), checkpoint_every=10_000, task_kwargs=task_kwargs)
@@ -135,20 +174,42 @@ def test_randomised_training_runs_and_resumes_bit_for_bit(tmp_path):
     assert_same_run(a, b)
 
 
-def test_robostrich_train_takes_the_perturbation_as_a_task_option(tmp_path):
-    """--task-kwargs carries it into every lesson's task and the checkpoint's fingerprint (and so
-    through robostrich-sweep, which passes training flags on); a bad scale is refused first."""
-    perturbation = {"latency": 0.2, "mass": 0.2}
+def test_robostrich_train_randomizes_and_its_policy_carries_what_it_observes(tmp_path):
+    """--randomize puts the per-episode robot (and, with latency, the sent actions observed) into
+    every lesson's task and the checkpoint's fingerprint (and so through robostrich-sweep, which
+    passes training flags on); evaluation, the policy file and the robustness tool rebuild the
+    observation from it; bad scales and families are refused first."""
+    from agents.robostrich import evaluation, robustness
+    from agents.robostrich.policy_export import export_policy
     args = ["--plan", "robostrich/lesson2:300", "--hidden-sizes", "32,32", "--batch-size", "32",
             "--min-replay-size", "100", "--updates-per-call", "4", "--env-steps-per-call", "8",
             "--checkpoint-every", "100", "--no-figures", "--no-rerun", "--quiet", "--no-baseline"]
     with pytest.raises(TrainingInterrupted):
-        training.main(args + ["--task-kwargs", json.dumps({"perturbation": perturbation}),
-                              "--out", str(tmp_path / "run"), "--stop-at-step", "120"])
-    fingerprint = checkpoint.read_fingerprint(str(tmp_path / "run" / "curriculum" / "checkpoint.ckpt"))
-    assert fingerprint["task_kwargs"]["perturbation"] == perturbation
-    with pytest.raises(ValueError, match="mass"):
-        training.main(args + ["--task-kwargs", '{"perturbation": {"mass": 2}}', "--out", str(tmp_path / "bad")])
+        training.main(args + ["--randomize", "all=0.2,latency=0.5", "--out", str(tmp_path / "run"),
+                              "--stop-at-step", "120"])
+    path = str(tmp_path / "run" / "curriculum" / "checkpoint.ckpt")
+    fingerprint = checkpoint.read_fingerprint(path)
+    assert fingerprint["task_kwargs"]["perturbation"] == {
+        **{family: 0.2 for family in perturbations.ARM_FAMILIES}, "latency": 0.5, "vary": True}
+    assert fingerprint["task_kwargs"]["observe_sent_actions"] == perturbations.MAX_LATENCY_STEPS
+    assert evaluation.checkpoint_domain(fingerprint).sent_actions == 3
+    policy = export_policy(path, str(tmp_path / "policy.npz"))
+    assert policy.task_kwargs() == {"observe_sent_actions": 3}
+    with pytest.raises(policies.PolicyMismatch, match="observe_sent_actions"):
+        policy.check(robostrich_suite.load("robostrich", "track"))
+    evaluated = robustness.load_evaluated(str(tmp_path / "policy.npz"), "robust")
+    row = robustness.evaluate(evaluated, Perturbation(latency=0.1), num_targets=1)
+    assert row["heldout"]["episodes"] == 1 and row["heldout_moving"]["episodes"] == 3
+    for flags, message in ((["--randomize", "trunk_height=0.1"], "trunk_height do not apply"),
+                           (["--task-kwargs", '{"perturbation": {"mass": 2}}'], "mass"),
+                           (["--randomize", "mass=0.1", "--task-kwargs", '{"perturbation": {"mass": 0.1}}'],
+                            "give one")):
+        with pytest.raises(ValueError, match=message):
+            training.main(args + flags + ["--out", str(tmp_path / "bad")])
+    for text, message in (("mass=2", "mass must be a scale from 0 to 1"), ("mas=0.1", "'mas=0.1'"),
+                          ("latency", "FAMILY=SCALE"), ("mass=x", "mass: expected a scale")):
+        with pytest.raises(ValueError, match=message):
+            perturbations.parse_scales(text)
 
 
 def test_the_command_writes_its_figure_json_and_a_results_record(tmp_path):

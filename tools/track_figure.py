@@ -11,7 +11,7 @@ import sys
 
 from agents.replay import ObservationFlattener
 from agents.robostrich import evaluation, figures
-from agents.robostrich.domains import TRACK_TASK, as_domain
+from agents.robostrich.domains import TRACK_TASK, as_domain, domain_of
 from agents.robostrich.lookup import LookupPolicy
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import policies
@@ -24,7 +24,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--out", default="docs/track_ventral_slips.png", help="the PNG (default: %(default)s)")
     args = parser.parse_args(argv)
     policy = policies.load_policy(args.policy)
-    domain = as_domain(policy.info.get("domain", "robostrich"), policy.info.get("layout"))
+    domain = domain_of(policy.info)
     reports = {"curriculum": evaluation.evaluate_track(policy, policy.flatten, domain, TRACK_TASK)}
     flattener = ObservationFlattener(evaluation.make_environment(domain, TRACK_TASK, 0).observation_spec())
     reports["lookup"] = evaluation.evaluate_track(LookupPolicy(flattener, domain.lookup_table()), flattener,

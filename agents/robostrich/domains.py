@@ -7,6 +7,10 @@ exist, instead of testing domain names themselves.  Every domain in
 frame, ``robostrich_a1`` on the quadruped, targets in its trunk frame); any
 other name is a dm_control suite domain, scored by episode returns.
 
+An arm domain may also observe the actions it sent (``sent_actions`` = k, the task option
+``observe_sent_actions``): a policy trained so reads an observation the others lack, so every
+environment made for it, in training, evaluation, play and the robustness tool, must carry it.
+
 An arm domain may name a built-in tendon layout (``robostrich_suite.model.layouts``):
 its lessons then use that layout and its shipped level poses, and the
 held-out targets and the lookup table come from the same file, so an agent
@@ -31,9 +35,11 @@ def arm_domains() -> Tuple[str, ...]:
 
 @dataclasses.dataclass(frozen=True)
 class Domain:
-    """A domain name plus, on the arm, a built-in tendon layout (default: the tasks' own)."""
+    """A domain name plus, on the arm, a built-in tendon layout (default: the tasks' own) and the
+    number of sent actions its observation holds (module doc)."""
     name: str
     layout: Optional[str] = None
+    sent_actions: int = 0
 
     def __post_init__(self):
         if self.layout is None and self.is_arm:  # the tasks' own routing, by name
@@ -45,6 +51,13 @@ class Domain:
                                  f"not to {self.name!r}")
             from robostrich_suite.model import layouts
             layouts.target_file(self.layout)  # names the built-in layouts, or those that ship targets
+        if self.sent_actions:
+            if not self.is_arm:
+                raise ValueError(f"observe_sent_actions applies to the arm domains {list(arm_domains())}, "
+                                 f"not to {self.name!r}")
+            from robostrich_suite.tasks import options, reach
+            object.__setattr__(self, "sent_actions", options.whole(
+                "observe_sent_actions", self.sent_actions, 0, reach.MAX_SENT_ACTIONS, "a whole number of control steps"))
 
     # -- what kind of domain -----------------------------------------------------------------
     @property
@@ -112,6 +125,8 @@ class Domain:
     def make_environment(self, task: str, seed: int, **task_kwargs):
         """robostrich_suite.load for the arm (with the layout's kwargs), dm_control.suite.load otherwise."""
         task_kwargs = {"random": seed, **self.layout_kwargs(task), **task_kwargs}
+        if self.sent_actions:
+            task_kwargs.setdefault("observe_sent_actions", self.sent_actions)
         if (self.is_arm and (task_kwargs.get("stored_starts") or task_kwargs.get("fixed_stored_starts"))
                 and task_kwargs.get("start_inputs") is None):
             task_kwargs["start_inputs"] = self.stored_start_inputs()
@@ -174,7 +189,13 @@ class Domain:
         return lookup_table(self.lookup_table(), heldout=starts, exclusion=exclusion)["control"]
 
     def describe(self) -> str:
-        return self.name if self.layout is None else f"{self.name} (layout {self.layout})"
+        text = self.name if self.layout is None else f"{self.name} (layout {self.layout})"
+        return text + (f", observing {self.sent_actions} sent actions" if self.sent_actions else "")
+
+    def info(self) -> dict:
+        """What a policy file or report keeps to rebuild this domain (:func:`domain_of`)."""
+        return {"domain": self.name, **({"layout": self.layout} if self.layout else {}),
+                **({"observe_sent_actions": self.sent_actions} if self.sent_actions else {})}
 
 
 def spread_indices(count: int, wanted: int) -> np.ndarray:
@@ -186,6 +207,13 @@ def spread_indices(count: int, wanted: int) -> np.ndarray:
     if wanted >= count:
         return np.arange(count)
     return np.unique(np.round(np.linspace(0, count - 1, max(int(wanted), 1))).astype(int))
+
+
+def domain_of(info: dict, task_kwargs: Optional[dict] = None) -> Domain:
+    """The Domain a policy file's ``info`` (or a report's names) describes; ``task_kwargs`` (a run's)
+    may say what it observes."""
+    sent = info.get("observe_sent_actions", (task_kwargs or {}).get("observe_sent_actions", 0))
+    return Domain(str(info.get("domain", "robostrich")), info.get("layout"), sent)
 
 
 def as_domain(domain, layout: Optional[str] = None) -> Domain:

@@ -159,8 +159,7 @@ def heldout_targets(domain, num_targets: Optional[int] = None):
 
 
 def _names(domain) -> dict:
-    domain = as_domain(domain)
-    return {"domain": domain.name, **({"layout": domain.layout} if domain.layout else {})}
+    return as_domain(domain).info()
 
 
 def evaluate_heldout(actor, flattener, domain, task: str, num_targets: Optional[int] = None,
@@ -358,7 +357,9 @@ def checked_fingerprint(path: str) -> dict:
 def checkpoint_domain(fingerprint: dict):
     """The domain (and layout) a checkpoint's run trained its last lesson on."""
     from agents.robostrich.runs import parse_plan
-    return as_domain(parse_plan(fingerprint["plan"])[-1].domain, fingerprint.get("layout"))
+    from agents.robostrich.domains import domain_of
+    return domain_of({"domain": parse_plan(fingerprint["plan"])[-1].domain, "layout": fingerprint.get("layout")},
+                     fingerprint.get("task_kwargs"))
 
 
 def load_run_from_checkpoint(path: str):

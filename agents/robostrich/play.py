@@ -10,7 +10,7 @@ the recording in the browser until Ctrl-C (robostrich_suite/web_viewer.py).
 import os
 
 from agents.robostrich import evaluation, figures
-from agents.robostrich.domains import TRACK_TASK, as_domain
+from agents.robostrich.domains import TRACK_TASK, as_domain, domain_of
 from agents.robostrich.recording import open_recorder
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs, policies, web_viewer
@@ -70,7 +70,7 @@ def main(argv=None) -> dict:
     outputs.check_directory(args.out)
     web_viewer.check(args)
     policy = policies.load_policy(args.policy)
-    domain = as_domain(policy.info.get("domain", "robostrich"), policy.info.get("layout"))
+    domain = domain_of(policy.info)
     heldout_task = evaluation.default_heldout_task(domain, TRACK_TASK)
     env = evaluation.make_environment(domain, heldout_task, 0)
     policy.check(env)

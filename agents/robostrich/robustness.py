@@ -15,7 +15,7 @@ import os
 
 
 from agents.robostrich import evaluation
-from agents.robostrich.domains import Domain, as_domain
+from agents.robostrich.domains import Domain, as_domain, domain_of
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs
 from robostrich_suite import policies
@@ -34,7 +34,7 @@ class PerturbedDomain(Domain):
     its environments through ``Domain.make_environment``)."""
 
     def __init__(self, domain: Domain, perturbation: perturbations.Perturbation):
-        super().__init__(domain.name, domain.layout)
+        super().__init__(domain.name, domain.layout, domain.sent_actions)
         object.__setattr__(self, "perturbation", perturbation)
 
     def make_environment(self, task: str, seed: int, **task_kwargs):
@@ -91,7 +91,7 @@ def load_evaluated(spec: str, label: str) -> Evaluated:
         return Evaluated(label, SACBuilder.make_eval_actor(run.loop), run.loop.flattener, domain,
                          run.config.action_repeat, spec)
     policy = policies.load_policy(spec)
-    domain = as_domain(policy.info.get("domain", "robostrich"), policy.info.get("layout"))
+    domain = domain_of(policy.info)
     env = evaluation.make_environment(domain, evaluation.default_heldout_task(domain, "track"), 0)
     policy.check(env)
     env.close()

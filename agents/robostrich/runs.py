@@ -129,4 +129,5 @@ class DomainRun(curriculum.CurriculumRun):
 
     def domain(self, lesson: Optional[Lesson] = None):
         """The Domain of `lesson` (default: the last), with this run's layout."""
-        return as_domain((lesson or self.plan[-1]).domain, self.layout)
+        from agents.robostrich.domains import Domain
+        return Domain((lesson or self.plan[-1]).domain, self.layout, self.task_kwargs.get("observe_sent_actions", 0))

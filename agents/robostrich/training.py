@@ -216,6 +216,37 @@ def _json_object(text: str) -> dict:
     return value
 
 
+def _scales(text: str) -> dict:
+    from robostrich_suite.tasks import perturbations
+    try:
+        return perturbations.parse_scales(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
+def apply_randomize(scales: Optional[dict], task_kwargs: dict, domain: Domain) -> dict:
+    """--randomize FAMILY=S,... as the task options: the robot drawn per episode up to each scale
+    (robostrich_suite/tasks/perturbations.py, ``vary``) and, with latency, the last
+    ``MAX_LATENCY_STEPS`` sent actions observed, so that what is on its way to the servos is in
+    the observation (unless --task-kwargs sets ``observe_sent_actions``)."""
+    if not scales:
+        return task_kwargs
+    from robostrich_suite.tasks import perturbations
+    if not domain.is_arm:
+        raise ValueError(f"--randomize applies to the arm domains, not to {domain.name!r}")
+    if "perturbation" in task_kwargs:
+        raise ValueError("--randomize and --task-kwargs' perturbation both set the robot's differences; give one")
+    families = perturbations.FAMILIES if domain.on_quadruped else perturbations.ARM_FAMILIES
+    try:
+        perturbation = perturbations.training_perturbation(scales, families)
+    except ValueError as error:
+        raise ValueError(f"--randomize: {error}") from None
+    extra = {"perturbation": perturbation}
+    if perturbation.get("latency"):
+        extra["observe_sent_actions"] = task_kwargs.get("observe_sent_actions", perturbations.MAX_LATENCY_STEPS)
+    return {**task_kwargs, **extra}
+
+
 def _add_run_arguments(run) -> None:
     """robostrich-train's flags for what to train: domain, plan, seed, layout, start, workers."""
     run.add_argument("--domain", default="robostrich",
@@ -255,6 +286,12 @@ def _add_run_arguments(run) -> None:
                           "\"target_sampling\": \"uniform\", "
                           "\"fixed_stored_starts\": 0}' gives the paper's eq. 10, its uniform draw of targets and "
                           "its fixed starts in lessons 1-2)")
+    run.add_argument("--randomize", type=_scales, default=None, metavar="FAMILY=S,...",
+                     help="train across robots that differ from the model: each episode draws each family's "
+                          "scale from [0, S] (families and scales as robostrich-robustness measures them, "
+                          "robostrich_suite/tasks/perturbations.py; all=S for every family); with latency the "
+                          "policy also observes its last 3 sent actions, which evaluation and its policy file "
+                          "carry (default: the nominal robot)")
     run.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
                      help="also train plain SAC on the final lesson with the same total budget (default: "
                           "--baseline)")
@@ -764,7 +801,8 @@ def prepare(args, argv) -> _Setup:
     final = plan[-1]
     final_domain = Domain(final.domain)
     args.layout = resolve_layout(args.layout, final_domain)
-    args.task_kwargs = resolve_task_kwargs(args.task_kwargs, final_domain)
+    args.task_kwargs = apply_randomize(getattr(args, "randomize", None),
+                                       resolve_task_kwargs(args.task_kwargs, final_domain), final_domain)
     try:
         domain = Domain(final.domain, args.layout)
     except ValueError as error:
@@ -772,6 +810,7 @@ def prepare(args, argv) -> _Setup:
     for lesson in plan:  # a typo fails now, not after the first lessons have trained
         Domain(lesson.domain).check_task(lesson.task)
     check_task_kwargs(plan, args.layout, args.task_kwargs)
+    domain = dataclasses.replace(domain, sent_actions=args.task_kwargs.get("observe_sent_actions", 0))
     check_goal_free_terms(args.task_kwargs, config)
     try:
         check_lesson_names(plan, config, lessons, args.layout)

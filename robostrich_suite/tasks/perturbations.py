@@ -30,6 +30,11 @@ moving starts do, keeps the previous episode's robot):
 * ``gait_timing`` (quadruped, walking): the gait's clock runs at a rate drawn uniformly from
   [1-s, 1+s] and starts at a phase drawn uniformly from [0, s] of a second.
 
+With ``vary`` (training across robots rather than measuring one), each fresh episode first draws
+each family's scale uniformly from [0, s] (latency: a whole number of steps from 0 to
+``latency_steps(s)``), then the family's draws at that scale: the robots trained on then span the
+nominal one up to s, where without ``vary`` a latency is always exactly ``latency_steps(s)``.
+
 The draws of each family come from their own stream seeded from one number the task's
 RandomState draws per fresh episode: a family's draws do not depend on which other families
 are on, and "all families at once" perturbs each exactly as alone.
@@ -67,6 +72,36 @@ FIELDS = {
 }
 
 
+def parse_scales(text: str) -> dict:
+    """``FAMILY=S,...`` (``all=S`` for every family of the domain, named ones over it) as
+    {name: scale}; a ValueError naming the problem for an unknown family or a bad scale."""
+    scales = {}
+    for item in filter(None, (part.strip() for part in text.split(","))):
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not sep or name not in FAMILIES + ("all",):
+            raise ValueError(f"expected FAMILY=SCALE items with FAMILY one of all, {', '.join(FAMILIES)}; got {item!r}")
+        try:
+            scale = float(value)
+        except ValueError:
+            raise ValueError(f"{name}: expected a scale from 0 to {MAX_SCALE:g}, got {value.strip()!r}") from None
+        scales[name] = options.number(name, scale, 0.0, MAX_SCALE, f"a scale from 0 to {MAX_SCALE:g}")
+    if not scales:
+        raise ValueError("expected FAMILY=SCALE items, e.g. all=0.3,latency=0.5")
+    return scales
+
+
+def training_perturbation(scales: dict, families) -> dict:
+    """The task option ``perturbation`` that trains across robots up to ``scales`` ({name: s}, ``all``
+    for every one of ``families``): each family's scale drawn per episode (``vary``)."""
+    unknown = [name for name in scales if name != "all" and name not in families]
+    if unknown:
+        raise ValueError(f"{', '.join(unknown)} do not apply here (the families here: {', '.join(families)})")
+    chosen = {family: scales["all"] for family in families} if "all" in scales else {}
+    chosen.update({name: s for name, s in scales.items() if name != "all"})
+    return {**{f: s for f, s in chosen.items() if s > 0}, "vary": True}
+
+
 def latency_steps(scale: float) -> int:
     """Control steps of delay at ``scale``: round(6 s), at most 3 (module doc)."""
     return min(MAX_LATENCY_STEPS, int(np.floor(scale * LATENCY_STEPS_PER_SCALE + 0.5)))
@@ -84,11 +119,13 @@ class Perturbation:
     latency: float = 0.0
     trunk_height: float = 0.0
     gait_timing: float = 0.0
+    vary: bool = False  # draw each family's scale per episode from [0, s] (module doc)
 
     def __post_init__(self):
         for family in FAMILIES:
             value = options.number(family, getattr(self, family), 0.0, MAX_SCALE, f"a scale from 0 to {MAX_SCALE:g}")
             object.__setattr__(self, family, float(value))
+        object.__setattr__(self, "vary", options.flag("vary", self.vary))
 
     @classmethod
     def of(cls, families, scale: float) -> "Perturbation":
@@ -112,6 +149,7 @@ class Perturber(Randomizer):
     def __init__(self, config: Perturbation):
         super().__init__(config)
         self._latency = latency_steps(config.latency)
+        self._joint_noise = config.joint_noise  # this episode's scale (``vary`` draws it)
         self._pending = collections.deque()
         self.trunk_height_offset = 0.0
         self.gait_rate = 1.0
@@ -124,12 +162,15 @@ class Perturber(Randomizer):
         n["frictionloss"] = model.dof_frictionloss[n["dofs"]].copy()
 
     def checkpoint_state(self) -> dict:
-        return {**super().checkpoint_state(), "pending": [np.array(a) for a in self._pending],
+        return {**super().checkpoint_state(), "latency": self._latency, "joint_noise": self._joint_noise,
+                "pending": [np.array(a) for a in self._pending],
                 "trunk_height_offset": self.trunk_height_offset, "gait_rate": self.gait_rate,
                 "gait_phase": self.gait_phase}
 
     def restore_checkpoint_state(self, state: dict) -> None:
         super().restore_checkpoint_state(state)
+        self._latency = int(state.get("latency", self._latency))
+        self._joint_noise = float(state.get("joint_noise", self._joint_noise))
         self._pending = collections.deque(np.array(a, np.float64) for a in state["pending"])
         self.trunk_height_offset = float(state["trunk_height_offset"])
         self.gait_rate = float(state["gait_rate"])
@@ -145,6 +186,15 @@ class Perturber(Randomizer):
         seed = int(random.randint(2**31))
         stream = {f: np.random.RandomState([seed, i]) for i, f in enumerate(FAMILIES)}
         n, model, drawn = self._nominal, physics.model, {}
+        scale = {f: getattr(c, f) for f in FAMILIES}
+        if c.vary:  # this episode's scale of each family that is on, from its own stream first
+            for family in c.active():
+                scale[family] = float(stream[family].uniform(0.0, scale[family]))
+            self._latency = (int(stream["latency"].randint(0, latency_steps(c.latency) + 1)) if c.latency else 0)
+            drawn["scale"] = {f: scale[f] for f in c.active()}
+            drawn["latency_steps"] = self._latency
+        c = dataclasses.replace(c, **scale)
+        self._joint_noise = c.joint_noise
 
         def factors(family, size):
             s = getattr(c, family)
@@ -212,7 +262,7 @@ class Perturber(Randomizer):
         return self._pending.popleft()
 
     def observe_joint_angles(self, angles: np.ndarray, random: np.random.RandomState) -> np.ndarray:
-        if not self.config.joint_noise:
+        if not self.config.joint_noise:  # off: nothing drawn (with ``vary`` at 0 this episode, a draw of 0)
             return angles
-        return angles + random.normal(0.0, self.config.joint_noise * JOINT_NOISE_AT_1, size=angles.shape)
+        return angles + random.normal(0.0, self._joint_noise * JOINT_NOISE_AT_1, size=angles.shape)
 

@@ -66,6 +66,10 @@ class ReachConfig:
     its fields) drawing new arm parameters every episode, None = off; perturbation: a
     ``perturbations.Perturbation`` (or a dict of its fields), the robot differing from the model by
     the families and scales it names (the robustness tool's and ``--randomize``'s), None = off.
+    observe_sent_actions: k > 0 adds the observation ``sent_actions``, the last k actions the agent
+    sent (clipped, newest first; at an episode's start the inputs the servos hold): with an
+    action latency of up to k control steps the actions still on their way to the servos are then
+    in the observation, which the arm's state alone does not show.
     """
     reward: str = "lesson2"
     initial_state: str = "fixed"
@@ -83,6 +87,10 @@ class ReachConfig:
     release_time: float = RELEASE_TIME
     fixed_stored_starts: float = 0.0
     perturbation: object = None
+    observe_sent_actions: int = 0
+
+
+MAX_SENT_ACTIONS = 8  # control steps of sent actions an observation may hold
 
 
 def default_config() -> ReachConfig:
@@ -121,6 +129,9 @@ class Reach(base.Task):
             if self.randomizer is not None:
                 raise ValueError("randomization and perturbation both change the robot; set one of them")
             self.randomizer = perturbations_lib.Perturber(perturbation)
+        self.observe_sent_actions = options.whole("observe_sent_actions", config.observe_sent_actions, 0,
+                                                  MAX_SENT_ACTIONS, "a whole number of control steps")
+        self._sent_actions = None  # (observe_sent_actions, tendons), newest first, see before_step
         self._robot_ready = False  # see _begin_robot
         self.target_position = self.target_pool[0].copy()
         self._last_reached = None
@@ -193,6 +204,8 @@ class Reach(base.Task):
                           if self.initial_state == "continue" else None)
         if self.randomizer is not None:
             self.randomizer.begin_actions(physics.arm_control())
+        if self.observe_sent_actions:
+            self._sent_actions = np.tile(physics.arm_control(), (self.observe_sent_actions, 1))
         self.target_position = self.next_target()
         super().initialize_episode(physics)
         self._continues_from_physics = True
@@ -240,7 +253,8 @@ class Reach(base.Task):
         return {"target_position": self.target_position, "last_reached": self._last_reached,
                 "continues_from_physics": self._continues_from_physics, "action_change": self._action_change,
                 "initial_state": self.initial_state, "sampler": self.sampler.checkpoint_state(),
-                "randomizer": None if self.randomizer is None else self.randomizer.checkpoint_state()}
+                "randomizer": None if self.randomizer is None else self.randomizer.checkpoint_state(),
+                "sent_actions": None if self._sent_actions is None else self._sent_actions.copy()}
 
     def restore_checkpoint_state(self, state: dict) -> None:
         """Continue from :meth:`checkpoint_state`'s variables (ValueError if they do not fit this task)."""
@@ -254,6 +268,8 @@ class Reach(base.Task):
         self.sampler.restore_checkpoint_state(state["sampler"])
         if self.randomizer is not None:
             self.randomizer.restore_checkpoint_state(state["randomizer"])
+        sent = state.get("sent_actions")
+        self._sent_actions = None if sent is None else np.array(sent, np.float64)
         self._head_reading = None
 
     def action_spec(self, physics):
@@ -273,6 +289,10 @@ class Reach(base.Task):
 
     def _set_action(self, action, physics) -> None:
         controls = physics.arm_control_view()
+        if self._sent_actions is not None:  # the observation's memory of what was sent
+            action = check_action(action, physics.arm_control_bounds())
+            self._sent_actions[1:] = self._sent_actions[:-1]
+            self._sent_actions[0] = action
         if self.randomizer is not None:  # an action may reach the servos late (tasks.perturbations)
             action = self.randomizer.delayed(check_action(action, physics.arm_control_bounds()))
         if controls is None:
@@ -368,6 +388,10 @@ class Reach(base.Task):
         obs["head_attitude"] = np.array([math.radians(attitude)])
         obs["tendon_contraction"] = physics.tendon_contractions()
         obs["tendon_tension"] = physics.tendon_tensions()
+        if self.observe_sent_actions:
+            sent = self._sent_actions
+            obs["sent_actions"] = (np.tile(physics.arm_control(), self.observe_sent_actions) if sent is None
+                                   else sent.ravel().copy())
         return obs
 
     def get_reward(self, physics):
