@@ -196,6 +196,57 @@ def test_the_space_round_trips_a_routing_and_refuses_one_outside_it():
         design_space.parameters(layouts.build("antagonist_pairs"))
 
 
+def _skipping_slips(tmp_path, insertions=("c14", "c10", "c6", "c2")) -> str:
+    """A layout file beyond the paper's family: its dorsal tendon and ventral slips 4 joints long,
+    holed every other link."""
+    names = design_space.SPEC.joint_names
+    ventral = [arm.TendonSpec(f"ventral_{link}", "ventral",
+                              design_space.holes(names.index(link), names.index(link) + 4, 2),
+                              on_base=names.index(link) + 4 == len(names) - 1)
+               for link in insertions]
+    layout = arm.TendonLayout((layouts.build("ventral_slips").tendons[0], *ventral))
+    path = tmp_path / "skipping_slips.json"
+    path.write_text(json.dumps(layouts.to_dict(layout, "skipping_slips")))
+    return str(path)
+
+
+def test_a_search_beyond_the_family_writes_routings_of_the_asked_tendons_that_load_as_a_task(tmp_path, capsys):
+    out = tmp_path / "out"
+    beyond = ["--ventral-tendons", "4", "--max-hole-stride", "2"]
+    summary = design.main(["--trials", "1", "--out", str(out), "--start-from", _skipping_slips(tmp_path), *beyond,
+                           *TINY])
+    (row,) = summary["front"]  # the slips pass the rolling/lever test
+    assert summary["tendons"] == {"dorsal": 1, "ventral": 4, "max_hole_stride": 2}
+    name, layout = layouts.read_file(row["layout_file"])
+    assert [t.side for t in layout.tendons] == ["dorsal"] + ["ventral"] * 4
+    assert layout.tendons[1].links == ("c18", "c16", "c14")  # holes every other link, origin to insertion
+    env = robostrich_suite.load("robostrich", "lesson1", task_kwargs={"tendon_layout": row["layout_file"]})
+    assert env.action_spec().shape == (5,)
+    step = env.step(np.full(5, 0.01))
+    assert np.isfinite(step.observation["head_position"]).all()
+    assert layout_compare.make_cases([], [row["layout_file"]], [])[0].layout == layout
+    # The study keeps its tendon counts: resuming with others is one line naming them.
+    for other in (["--ventral-tendons", "12", "--max-hole-stride", "2"], ["--dorsal-tendons", "2", *beyond], []):
+        capsys.readouterr()
+        assert design.cli(["--trials", "0", "--out", str(out), *other, *TINY]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "was started with --pose-budget 6 --ventral-tendons 4 --max-hole-stride 2:" in err
+
+
+def test_the_space_beyond_the_family_round_trips_its_routings_and_counts_its_tendons(tmp_path):
+    space = design_space.Space(dorsal=2, ventral=12, max_stride=3)
+    names = space.tendon_names()
+    assert names[:3] == ["dorsal", "dorsal_2", "ventral_1"] and len(names) == 14
+    params = {f"{name}_{key}": value for k, name in enumerate(names)
+              for key, value in (("insertion", k % 16), ("span", 1 + k % 9), ("offset", 0.01), ("stride", 1 + k % 3))}
+    layout = design_space.layout(params)
+    assert len(layout) == 14 and layout.names[:2] == ("dorsal", "dorsal_2")
+    assert design_space.layout(design_space.parameters(layout, space=space)) == layout
+    _, skipping = layouts.read_file(_skipping_slips(tmp_path))
+    with pytest.raises(ValueError, match="skips links"):
+        design_space.parameters(skipping, space=design_space.Space(ventral=4))
+
+
 # --------------------------------------------------------------------------- the command
 
 def _complete(db) -> int:
@@ -270,6 +321,10 @@ def test_ctrl_c_marks_the_running_trial_failed_and_keeps_the_finished_ones(tmp_p
     (["--slot-x", "0.3"], "--slot-x: must be two numbers MIN,MAX"),
     (["--slot-x", "0.1,nan"], "--slot-x: must be two numbers MIN,MAX"),
     (["--slot-x=-2,0.1"], "--slot-x: must lie within -1 to 1 m"),
+    (["--ventral-tendons", "17"], "--ventral-tendons: must be from 2 to 16"),
+    (["--dorsal-tendons", "0"], "--dorsal-tendons: must be from 1 to 4"),
+    (["--max-hole-stride", "x"], "--max-hole-stride: invalid whole number"),
+    (["--ventral-tendons", "4", "--start-from", "ventral_slips"], "1 dorsal and 4 ventral tendons, this one 1 and 8"),
 ])
 def test_bad_input_is_one_line_and_exit_status_2(argv, message, tmp_path, capsys):
     assert _status([*argv, "--out", str(tmp_path / "out")]) == 2

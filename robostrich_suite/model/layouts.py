@@ -42,7 +42,10 @@ from typing import Callable
 
 from robostrich_suite.model import arm as arm_lib
 
-MAX_TENDONS = 9  # the paper's 9 servos: the comparison is at the same actuation budget
+MAX_TENDONS = 9  # the paper's 9 servos: the built-ins compare at the same actuation budget
+# A layout file may have more (robostrich-design's searches beyond the paper's family write them,
+# up to 4 dorsal + 16 ventral); robostrich-layouts' table gives each case's count.
+MAX_FILE_TENDONS = 20
 DATA_DIR = pathlib.Path(__file__).resolve().parents[1] / "data"
 
 # Antagonist pairs: the neck cut into four stretches, each with a dorsal and a ventral

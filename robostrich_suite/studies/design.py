@@ -7,6 +7,13 @@ The space is :mod:`robostrich_suite.studies.design_space` (Table 1's links, one 
 ventral tendons through run-through holes; origins, insertions and hole offsets searched).
 Each trial is scored cheaply (:mod:`robostrich_suite.studies.design_objectives`, ``--pose-budget``).
 
+**Beyond the paper's family** (2026-12-05): ``--ventral-tendons N`` (2-16) and ``--dorsal-tendons M``
+(1-4) change the tendon counts, and ``--max-hole-stride K`` (1-4) lets each tendon's holes be up to
+K links apart, skipping the links between (``design_space.Space``: the one other insertion the
+generator builds as it is; a tendon tied at two links short of the base is already in the family).
+More tendons are more servos: the written layout files give the tasks a larger action spec.  All
+three are fixed for a study, as ``--pose-budget`` is, and ``--start-from`` must fit them.
+
 **Two objectives and one constraint.**  Maximised: the share of the blue region held level
 (coverage) and the height of the gap column (the narrow gap's measure).  Constrained: the
 rolling/lever attitude ratio at most :data:`RATIO_LIMIT`, the paper's "well below 1" made a
@@ -56,6 +63,7 @@ import warnings
 
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs
+from robostrich_suite.studies import design_space
 
 PROG = "robostrich-design"
 RATIO_LIMIT = 0.6  # rolling / lever attitude ratio a routing must not pass (module doc)
@@ -114,9 +122,18 @@ def build_parser() -> cli_lib.Parser:
     parser.add_argument("--score-passage", action="store_true",
                         help="score the way into the gap from under the shelf instead of the column's height, "
                              "fixed for a study (module doc)")
+    parser.add_argument("--dorsal-tendons", type=cli_lib.whole_number(*design_space.DORSAL_RANGE),
+                        default=design_space.DORSAL_TENDONS, metavar="M",
+                        help="dorsal tendons per routing, fixed for a study (default: %(default)s, the paper's)")
+    parser.add_argument("--ventral-tendons", type=cli_lib.whole_number(*design_space.VENTRAL_RANGE),
+                        default=design_space.VENTRAL_TENDONS, metavar="N",
+                        help="ventral tendons per routing, fixed for a study (default: %(default)s, the paper's)")
+    parser.add_argument("--max-hole-stride", type=cli_lib.whole_number(*design_space.STRIDE_RANGE), default=1,
+                        metavar="K", help="search each tendon's holes every 1..K links (K > 1: holes that skip "
+                                          "links), fixed for a study (default: %(default)s, the paper's: every link)")
     parser.add_argument("--start-from", nargs="+", default=[], metavar="LAYOUT",
-                        help="built-in layouts or layout files tried first, when the study is new "
-                             "(each must be in the space: 1 dorsal + 8 ventral tendons through every link; default: none)")
+                        help="built-in layouts or layout files tried first, when the study is new (each must be "
+                             "in the space: the tendon counts asked, holed every link or every K; default: none)")
     parser.add_argument("--confirm", type=cli_lib.whole_number(0, 50), default=0, metavar="K",
                         help="full measures of the front's best K routings (by gap column, then coverage; "
                              "default: %(default)s)")
@@ -127,11 +144,12 @@ def build_parser() -> cli_lib.Parser:
 def main(argv=None) -> dict:
     args = build_parser().parse_args(argv)
     from robostrich_suite.studies import design_report, design_study
-    starts = [design_study.start_layout(item) for item in args.start_from]  # bad ones fail before any work
+    space = design_space.Space(args.dorsal_tendons, args.ventral_tendons, args.max_hole_stride)
+    starts = [design_study.start_layout(item, space) for item in args.start_from]  # bad ones fail before any work
     outputs.check_directory(args.out)
     args.out.mkdir(parents=True, exist_ok=True)
     storage_url = args.storage or f"sqlite:///{(args.out / 'study.db').resolve()}"
-    settings = design_study.Settings(args.pose_budget, args.search_stiffness, args.slot_x, args.score_passage)
+    settings = design_study.Settings(args.pose_budget, args.search_stiffness, args.slot_x, args.score_passage, space)
     study = design_study.open_study(storage_url, args.study_name, settings, args.seed)
     command = shlex.join([PROG, *(sys.argv[1:] if argv is None else argv)])
     with cli_lib.deferred_interrupts():

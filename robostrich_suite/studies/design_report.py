@@ -75,6 +75,8 @@ def summary(study, command: str, storage_url: str, layout_files: dict, confirmed
         "pose_budget": study.user_attrs.get("pose_budget"),
         "search_stiffness": study.user_attrs.get("search_stiffness"),
         "slot_x": None if settings.slot_x is None else list(settings.slot_x),
+        "tendons": {"dorsal": settings.space.dorsal, "ventral": settings.space.ventral,
+                    "max_hole_stride": settings.space.max_stride},
         "gap_objective": "passage" if settings.score_passage else "column",
         "sampler": "multi-objective TPE with constraints (Optuna)",
         "objectives": list(design.objectives(settings.score_passage)),

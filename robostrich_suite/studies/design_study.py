@@ -1,7 +1,7 @@
 """The Optuna study behind ``robostrich-design``: opening or resuming it, its trials, the front.
 
 A study is fixed to its :class:`Settings` (pose budget, searching the stiffness, the slot's range,
-scoring the way in; its user attributes): trials scored otherwise do not compare, so resuming
+scoring the way in, the tendons' counts and strides; its user attributes): trials scored otherwise do not compare, so resuming
 with others is refused.
 Each trial stores its measures as the user attribute ``result`` and the constraint
 (rolling/lever ratio minus ``design.RATIO_LIMIT``, feasible at <= 0) as the user attribute
@@ -27,23 +27,32 @@ class Settings:
     search_stiffness: bool = False
     slot_x: tuple | None = None  # (min, max) m of the slot's centre; None: anywhere
     score_passage: bool = False
+    space: design_space.Space = design_space.PAPER
 
     def attrs(self) -> dict:
         return {"pose_budget": self.pose_budget, "search_stiffness": self.search_stiffness,
-                "slot_x": None if self.slot_x is None else list(self.slot_x), "score_passage": self.score_passage}
+                "slot_x": None if self.slot_x is None else list(self.slot_x), "score_passage": self.score_passage,
+                "dorsal_tendons": self.space.dorsal, "ventral_tendons": self.space.ventral,
+                "max_hole_stride": self.space.max_stride}
 
     @classmethod
     def of(cls, study) -> "Settings":
         """The settings ``study`` was started with (one started before a flag existed: its default)."""
         attrs = study.user_attrs
         slot_x = attrs.get("slot_x")
+        space = design_space.Space(attrs.get("dorsal_tendons", design_space.DORSAL_TENDONS),
+                                   attrs.get("ventral_tendons", design_space.VENTRAL_TENDONS),
+                                   attrs.get("max_hole_stride", 1))
         return cls(attrs.get("pose_budget", cls.pose_budget), bool(attrs.get("search_stiffness")),
-                   None if slot_x is None else tuple(slot_x), bool(attrs.get("score_passage")))
+                   None if slot_x is None else tuple(slot_x), bool(attrs.get("score_passage")), space)
 
     def flags(self) -> str:
         return (f"--pose-budget {self.pose_budget}" + (" --search-stiffness" if self.search_stiffness else "")
                 + (f" --slot-x {self.slot_x[0]:g},{self.slot_x[1]:g}" if self.slot_x is not None else "")
-                + (" --score-passage" if self.score_passage else ""))
+                + (" --score-passage" if self.score_passage else "")
+                + (f" --dorsal-tendons {self.space.dorsal}" if self.space.dorsal != design_space.DORSAL_TENDONS else "")
+                + (f" --ventral-tendons {self.space.ventral}" if self.space.ventral != design_space.VENTRAL_TENDONS else "")
+                + (f" --max-hole-stride {self.space.max_stride}" if self.space.max_stride != 1 else ""))
 
 
 def _optuna():
@@ -94,14 +103,14 @@ def redacted(url: str) -> str:
         return url
 
 
-def start_layout(item: str):
-    """A built-in layout's name or a layout file, as search parameters (ValueError if outside the space)."""
+def start_layout(item: str, space: design_space.Space = design_space.PAPER):
+    """A built-in layout's name or a layout file, as search parameters (ValueError if outside ``space``)."""
     if item.lower().endswith((".json", ".toml")):
         name, layout = layouts_lib.read_file(item, design_space.SPEC)
     else:
         name, layout = item, layouts_lib.build(item)
     try:
-        return design_space.parameters(layout)
+        return design_space.parameters(layout, space=space)
     except ValueError as error:
         raise ValueError(f"--start-from {name}: {error}") from None
 
@@ -127,7 +136,7 @@ def objective(settings: Settings):
     budget = design_objectives.Budget(poses=settings.pose_budget)
 
     def score(trial):
-        params = design_space.suggest(trial, settings.search_stiffness)
+        params = design_space.suggest(trial, settings.search_stiffness, settings.space)
         result = design_objectives.evaluate(design_space.spec(params), design_space.layout(params), budget,
                                             cli_lib.interrupted, settings.slot_x, settings.score_passage)
         ratio = result["rolling_lever_ratio"]

@@ -210,9 +210,9 @@ def make_cases(names, files, stiffnesses) -> list[Case]:
             name, layout = layouts_lib.read_file(path, spec)
             layouts.append((name, layout, str(path)))
         for name, layout, source in layouts:
-            if len(layout) > layouts_lib.MAX_TENDONS:
+            if len(layout) > layouts_lib.MAX_FILE_TENDONS:
                 raise ValueError(f"layout {name!r} ({source}) has {len(layout)} tendons; the "
-                                 f"comparison is at the paper's {layouts_lib.MAX_TENDONS} servos at most")
+                                 f"comparison takes {layouts_lib.MAX_FILE_TENDONS} servos at most")
             cases.append(Case(f"{name}{suffix}", name, spec, layout, source))
     labels = [c.label for c in cases]
     duplicates = sorted({x for x in labels if labels.count(x) > 1})
