@@ -15,6 +15,19 @@ import pytest
 os.environ.setdefault("MUJOCO_GL", "egl")
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent / "tools"))
 
+def pytest_configure(config):
+    config.addinivalue_line("markers", "long: runs for tens of seconds; scheduled first (see below)")
+
+
+def pytest_collection_modifyitems(items):
+    """The modules with long tests first, each kept whole (its module-scoped fixtures, a finished
+    sweep or a shared XLA cache, are then set up once): the workers of ``-n 2`` share out the short
+    modules as they free up and finish together, instead of one starting a minute-long test when the
+    other has nothing left."""
+    long_modules = {item.module.__name__ for item in items if item.get_closest_marker("long")}
+    items.sort(key=lambda item: item.module.__name__ not in long_modules)
+
+
 RERUN_CLI_MISSING = ("the rerun command of rerun-sdk is not installed (neither beside this Python "
                      "nor on PATH): .rrd recordings not verified")
 

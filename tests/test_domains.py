@@ -94,6 +94,7 @@ def test_curriculum_runs_every_lesson_on_the_quadruped_and_carries_the_learner(t
     assert run.loop.env.task.legs == "walk"  # lesson 4: the quadruped trots
 
 
+@pytest.mark.long
 def test_a_layout_is_part_of_the_checkpoint(tmp_path):
     plan = parse_plan("lesson1:40")
     run = DomainRun(plan, TINY, 0, str(tmp_path / "run"), layout=LAYOUT)

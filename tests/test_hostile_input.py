@@ -93,6 +93,7 @@ FLAG_CASES = {  # (command, arguments, fragments the one line must hold)
 }
 
 
+@pytest.mark.long
 def test_bad_flags_exit_2_with_one_line_naming_the_flag(tmp_path):
     """Nonsense is refused before anything runs, with a bound named for every count and duration."""
     processes = {case: start(name, *args, cwd=tmp_path) for case, (name, args, _) in FLAG_CASES.items()}
@@ -132,6 +133,7 @@ def test_damaged_files_are_named_in_one_line(tmp_path):
     assert not any((tmp_path / d).exists() for d in ("s", "l1", "l2"))
 
 
+@pytest.mark.long
 def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
     """Two workers (the default): a second run in the same --out is refused while the first holds
     it; Ctrl-C checkpoints both runs and exits 130; --resume drops a torn last metrics line and

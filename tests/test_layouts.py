@@ -180,6 +180,7 @@ def test_the_fig1b_candidates_are_the_routings_with_the_papers_tendons():
     assert len(set(map(tuple, spans.values()))) == len(candidates)  # each routed another way
 
 
+@pytest.mark.long
 def test_the_fidelity_check_prints_the_candidates_table(tmp_path):
     """`--candidates` measures every candidate of Fig. 1B, the rolling/lever test included."""
     out = tmp_path / "out"

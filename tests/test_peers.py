@@ -63,6 +63,7 @@ def test_the_peer_actor_gives_contractions_in_the_task_range(tmp_path):
     assert action.shape == spec.shape and np.all(action >= spec.minimum) and np.all(action <= spec.maximum)
 
 
+@pytest.mark.long
 def test_the_command_writes_its_record_figure_and_table(tmp_path):
     """Our plain SAC, one peer and the lookup at a tiny budget, in worker processes as the real run."""
     sys.path.insert(0, str(TOOLS))

@@ -146,6 +146,7 @@ def finished_sweep(command_env):
     subprocess.run(["rm", "-rf", str(out)], check=True)
 
 
+@pytest.mark.long
 def test_a_two_by_two_sweep_finishes_and_its_table_aggregates_the_runs(finished_sweep):
     out, result = finished_sweep
     assert result.returncode == 0, result.stderr[-3000:]
@@ -250,6 +251,7 @@ def _stop_mid_training(run_dir: pathlib.Path, process, timeout=600):
     raise AssertionError(f"{run_dir} was not caught mid-training (sweep status {process.poll()})")
 
 
+@pytest.mark.long
 def test_a_killed_sweep_stops_its_runs_with_a_checkpoint_and_resumes_them_bit_for_bit(finished_sweep, command_env):
     """SIGKILL to the sweep while its second run trains (its first finished): the run stops, as by
     SIGTERM, with a checkpoint of where it was; started again, the sweep reruns nothing finished

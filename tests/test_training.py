@@ -154,6 +154,7 @@ def test_action_repeat_holds_actions_and_sums_rewards(tmp_path):
                                rtol=1e-5, atol=1e-4)
 
 
+@pytest.mark.long
 def test_runs_trained_in_worker_processes_equal_runs_trained_in_turn(tmp_path):
     """--workers 2 trains the curriculum and the baseline at once, one process each: same
     checkpoints and reports as training them one after the other."""

@@ -3,6 +3,7 @@ import json
 import os
 
 import numpy as np
+import pytest
 
 from agents.robostrich import evaluation
 from agents.robostrich.runs import DomainRun, parse_plan
@@ -14,11 +15,9 @@ from agents.sac.config import SACConfig
 CONFIG = SACConfig(batch_size=64, hidden_sizes=(64, 64), learning_rate=1e-3, init_temperature=0.01,
                    min_replay_size=1000, max_replay_size=30_000, updates_per_call=4, env_steps_per_call=4,
                    her_ratio=0.5, relabel_rewards=True, critic_layer_norm=True)
-# Measured here at 24k steps: success 0 -> 11/27 held-out targets, median error 0.43 -> 0.068 m
-# (the same run without those improvements: 2/27, 0.18 m). With the default pre-tanh penalty
-# (0.1), which pulls the policy toward mid-range inputs and so slows lesson 1's
-# first 24k steps: success 0 -> 6/27, median error 0.43 -> 0.135 m.
-STEPS = 24_000
+# 12k steps: untrained, no held-out target is reached (median error ~0.6 m); trained, most are
+# (2026-12-05: 68 %, median 2.5 cm), so the asserted gains leave a wide margin.
+STEPS = 12_000
 
 
 def position_report(run):
@@ -29,6 +28,7 @@ def position_report(run):
     return float(np.mean(errors <= 0.05)), float(np.median(errors))
 
 
+@pytest.mark.long
 def test_short_lesson1_training_improves_success_on_heldout_targets(tmp_path):
     run = DomainRun(parse_plan(f"robostrich/lesson1:{STEPS}"), CONFIG, seed=0, run_dir=str(tmp_path))
     untrained_success, untrained_error = position_report(run)
@@ -38,6 +38,7 @@ def test_short_lesson1_training_improves_success_on_heldout_targets(tmp_path):
     assert trained_success >= untrained_success + 0.15, (untrained_success, trained_success)
 
 
+@pytest.mark.long
 def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them(tmp_path, verify_rrd):
     from agents.robostrich import training
     out = str(tmp_path / "run")

@@ -173,6 +173,7 @@ def test_checkpoints_that_cannot_start_the_run_are_refused(source, tmp_path):
         np.testing.assert_array_equal(a, b)
 
 
+@pytest.mark.long
 def test_train_from_a_frame_checkpoint_end_to_end(source, tmp_path):
     _, path = source
     out = tmp_path / "a1"

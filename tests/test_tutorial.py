@@ -21,6 +21,7 @@ def test_the_tutorial_is_kept_without_outputs():
     assert not kept, f"cells {kept} keep outputs: clear them before committing"
 
 
+@pytest.mark.long
 def test_the_tutorial_runs_top_to_bottom(tmp_path, monkeypatch):
     nbformat = pytest.importorskip("nbformat", reason="nbformat is in the test extra")
     nbclient = pytest.importorskip("nbclient", reason="nbclient is in the test extra")

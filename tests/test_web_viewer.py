@@ -102,6 +102,7 @@ def _loaded(page, tmp_path, timeout: float = 240) -> tuple:
     return entities, views
 
 
+@pytest.mark.long
 def test_play_web_serves_the_recording_to_a_real_browser_and_stops_on_ctrl_c(tmp_path):
     playwright_api = pytest.importorskip("playwright.sync_api", reason="playwright is in the test extra")
     port = _free_ports()
