@@ -4,8 +4,8 @@ Finding the arm in a model (:func:`arm_indices`), which tendon is on which side
 (:func:`tendon_sides`) and the head's attitude are stated here once; tasks and
 studies alike read them from here.  :class:`ArmPhysicsMixin` is mixed into each
 domain's ``Physics`` so tasks read the head, joints and tendons by meaning rather
-than by index; :class:`QuadrupedPhysicsMixin` adds the quadruped's trunk, legs and
-the trunk frame.  Joint angles come in Table 1 order (atlas first, C18 last);
+than by index; robostrich_suite/quadruped_physics.py adds the quadruped's trunk, legs
+and the trunk frame.  Joint angles come in Table 1 order (atlas first, C18 last);
 tendons in actuator (= action) order.
 """
 from __future__ import annotations
@@ -20,8 +20,6 @@ from dm_control.mujoco import engine
 from dm_control.rl import control
 
 from robostrich_suite.model import arm as arm_lib
-from robostrich_suite.model import legs
-from robostrich_suite.model import quadruped as quad
 
 _log = logging.getLogger(__name__)
 # dm_control's message for an invalid state, so both step paths report it alike.
@@ -182,7 +180,7 @@ def attitude_error_deg(attitude_deg, desired_deg):
     return (np.asarray(attitude_deg) - desired_deg + 180.0) % 360.0 - 180.0
 
 
-def _continuous_attitude(axis_angle_rad: float, joint_angles_rad: np.ndarray) -> float:
+def one_pose_attitude_deg(axis_angle_rad: float, joint_angles_rad: np.ndarray) -> float:
     """:func:`continuous_attitude_deg` of one pose in plain floats (same result): the
     physics accessors run it once per control step."""
     axis_angle = math.degrees(axis_angle_rad)
@@ -288,7 +286,7 @@ class ArmPhysicsMixin:
         """Head attitude in degrees: 90 = head parallel to the ground (paper Fig. 2B); continuous
         past 180 (no wrap), see :func:`continuous_attitude_deg`."""
         xmat, joint_angles = self._head_frame_and_joints()  # row-major 3x3; column 2 = head axis
-        return _continuous_attitude(math.atan2(xmat[2], xmat[8]), joint_angles)
+        return one_pose_attitude_deg(math.atan2(xmat[2], xmat[8]), joint_angles)
 
     def joint_angles(self) -> np.ndarray:
         """The 18 joint angles (rad), atlas first; positive = ventral flexion."""
@@ -459,90 +457,3 @@ class ArmPhysicsMixin:
         self.divergence = None
         self.episodes_started += 1
         return super().reset(keyframe_id)
-
-
-class QuadrupedPhysicsMixin(ArmPhysicsMixin):
-    """The arm's accessors (``ArmPhysicsMixin``) plus the quadruped's and the trunk frame:
-    origin on the ground under the trunk centre, x along the trunk's heading (projected on
-    the ground), y to its left, z up (see :mod:`robostrich_suite.tasks.quadruped_tasks`)."""
-
-    def _robot(self):
-        cache = self.__dict__.get("_robot_cache")
-        if cache is None or cache["data"] is not self._data:  # a reload makes new data
-            model = self.model
-            legs = list(quad.JOINT_NAMES)
-            cache = dict(
-                data=self._data,
-                trunk=model.name2id(quad.TRUNK_BODY, "body"),
-                leg_actuators=np.array([model.name2id(n, "actuator") for n in legs]),
-                leg_qpos=np.array([model.jnt_qposadr[model.name2id(n, "joint")] for n in legs]),
-                # The arm's first (caudal) joint: the generator adds the chain caudal first.
-                arm_base=int(model.jnt_bodyid[arm_ids(model, "joint")[0]]))
-            self.__dict__["_robot_cache"] = cache
-        return cache
-
-    # Arm head.
-    def head_attitude(self) -> float:
-        """Head attitude (deg) in the trunk's heading plane: 0 up, 90 level, 180 down."""
-        xmat, joint_angles = self._head_frame_and_joints()  # row-major: axis z = (2, 5, 8)
-        hx, hy = self.heading()
-        return _continuous_attitude(math.atan2(xmat[2] * hx + xmat[5] * hy, xmat[8]), joint_angles)
-
-    # Quadruped.
-    def trunk_position(self) -> np.ndarray:
-        """Trunk centre (x, y, z), world frame."""
-        return self._raw_data.xpos[self._robot()["trunk"]].copy()
-
-    def trunk_velocity(self) -> np.ndarray:
-        """Trunk linear velocity, world frame (the free joint's linear velocity)."""
-        return self._raw_data.qvel[:3].copy()
-
-    def trunk_height(self) -> float:
-        return float(self._raw_data.xpos[self._robot()["trunk"], 2])
-
-    def trunk_uprightness(self) -> float:
-        """z component of the trunk's up axis: 1 upright, 0 on its side."""
-        return float(self._raw_data.xmat[self._robot()["trunk"]][8])
-
-    def heading(self) -> np.ndarray:
-        """Unit (x, y) of the trunk's forward axis projected on the ground."""
-        xmat = self._raw_data.xmat[self._robot()["trunk"]]
-        fx, fy = float(xmat[0]), float(xmat[3])
-        norm = math.hypot(fx, fy)
-        return (fx / norm, fy / norm) if norm > 1e-9 else (1.0, 0.0)
-
-    def to_trunk_frame(self, point, velocity: bool = False) -> np.ndarray:
-        """World point (or velocity) -> (forward, left, up) in the trunk frame (class doc)."""
-        hx, hy = self.heading()
-        x, y, z = (float(c) for c in point)
-        if not velocity:
-            trunk = self._raw_data.xpos[self._robot()["trunk"]]
-            x, y = x - trunk[0], y - trunk[1]
-        return np.array([hx * x + hy * y, -hy * x + hx * y, z])
-
-    def from_trunk_frame(self, forward: float, up: float) -> np.ndarray:
-        """(forward, up) in the trunk frame -> world point in the trunk's vertical plane."""
-        hx, hy = self.heading()
-        x, y, _ = self.trunk_position()
-        return np.array([x + forward * hx, y + forward * hy, up])
-
-    def arm_base_position(self) -> np.ndarray:
-        """World position of the arm's first joint (C18) on the trunk."""
-        return self._raw_data.xpos[self._robot()["arm_base"]].copy()
-
-    def set_leg_targets(self, targets) -> None:
-        self._raw_data.ctrl[self._robot()["leg_actuators"]] = targets
-
-    def place_standing(self, trunk_xy=(0.0, 0.0), trunk_height=quad.STANDING_TRUNK_HEIGHT):
-        """Put the quadruped in its standing pose, feet on the ground, arm straight, at rest."""
-        targets = legs.standing_joint_targets(trunk_height + legs.SAG_COMPENSATION["stand"])
-        _, foot_z = legs.leg_fk(targets[1], targets[2])
-        self._raw_data.qpos[:] = 0.0
-        self._raw_data.qpos[:3] = [trunk_xy[0], trunk_xy[1], -foot_z + quad.FOOT_RADIUS]
-        self._raw_data.qpos[3:7] = [1, 0, 0, 0]
-        self._raw_data.qpos[self._robot()["leg_qpos"]] = targets
-        self._raw_data.qvel[:] = 0.0
-        if self._raw_data.act.size:
-            self._raw_data.act[:] = 0.0
-        self.set_leg_targets(targets)
-        self.set_arm_control(0.0)

@@ -29,7 +29,7 @@ import functools
 from dm_control import mujoco
 from dm_control.utils import containers
 
-from robostrich_suite import physics as physics_lib
+from robostrich_suite import quadruped_physics
 from robostrich_suite import scenes
 from robostrich_suite.model import legs as legs_lib
 from robostrich_suite.tasks import lessons, options, target_samplers
@@ -52,7 +52,7 @@ def get_model_and_assets(arm_spec=None, tendon_layout=None, scene: str = "flat")
     return scenes.build_a1(arm_spec, tendon_layout, scene).to_xml_string(), {}
 
 
-class Physics(physics_lib.QuadrupedPhysicsMixin, mujoco.Physics):
+class Physics(quadruped_physics.QuadrupedPhysicsMixin, mujoco.Physics):
     """The arm's accessors plus the quadruped's and the trunk frame (``QuadrupedPhysicsMixin``)."""
 
 

@@ -13,6 +13,7 @@ import numpy as np
 from dm_control import mjcf, mujoco
 
 from robostrich_suite import physics as physics_lib
+from robostrich_suite import quadruped_physics
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite.model import quadruped as quad
 from robostrich_suite.model.timesteps import PHYSICS_TIMESTEP
@@ -88,7 +89,7 @@ GAP_SHELF_DEPTH = 0.45  # m, shelf extent behind the wall's near face
 WALL_THICKNESS = 0.04  # m
 
 
-class _StandingPhysics(physics_lib.QuadrupedPhysicsMixin, mujoco.Physics):
+class _StandingPhysics(quadruped_physics.QuadrupedPhysicsMixin, mujoco.Physics):
     """Places the composed robot in its standing pose for the ``stand`` keyframe."""
 
 

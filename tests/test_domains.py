@@ -122,16 +122,17 @@ def test_periodic_evaluation_targets_spread_over_the_held_out_set():
 def test_default_lessons_are_the_domains_curriculum():
     """Without --lessons/--plan, robostrich-train runs Algorithm 1 of the chosen domain: lessons 1-3
     on the frame, 1-4 (lesson 4 trotting) on the quadruped; a dm_control domain must name its tasks."""
-    from agents.robostrich import training
+    from agents.curriculum import LessonSettings
+    from agents.robostrich import main_job, training
     parse = training.build_parser().parse_args
-    frame = training.plan_from_args(parse(["--steps", "300"]))
+    frame = main_job.plan_from_args(parse(["--steps", "300"]))
     assert [(l.domain, l.task, l.steps) for l in frame] == [
         ("robostrich", "lesson1", 80), ("robostrich", "lesson2", 80), ("robostrich", "lesson3", 140)]  # 4:4:7
-    quadruped = training.plan_from_args(parse(["--domain", "robostrich_a1", "--steps", "1000"]))
+    quadruped = main_job.plan_from_args(parse(["--domain", "robostrich_a1", "--steps", "1000"]))
     assert [l.task for l in quadruped] == ["lesson1", "lesson2", "lesson3", "lesson4"]
     assert sum(l.steps for l in quadruped) == 1000
     with pytest.raises(ValueError, match="has no curriculum"):
-        training.plan_from_args(parse(["--domain", "cartpole"]))
+        main_job.plan_from_args(parse(["--domain", "cartpole"]))
 
 
 def test_quadruped_main_job_runs_all_four_lessons_and_resumes_mid_lesson4_exactly(tmp_path):
@@ -141,13 +142,14 @@ def test_quadruped_main_job_runs_all_four_lessons_and_resumes_mid_lesson4_exactl
     at a tiny budget: killed while the quadruped trots (its trunk height schedule under way), a run
     restored from its checkpoint continues exactly as the run that was never stopped."""
     from agents.curriculum import TrainingInterrupted
-    from agents.robostrich import training
+    from agents.curriculum import LessonSettings
+    from agents.robostrich import main_job, training
     args = training.build_parser().parse_args(["--domain", "robostrich_a1", "--steps", "300"])
-    plan = training.plan_from_args(args)
+    plan = main_job.plan_from_args(args)
     assert [(l.task, l.steps) for l in plan] == [("lesson1", 64), ("lesson2", 64), ("lesson3", 112), ("lesson4", 60)]
-    lessons = training.config_from_args(args, [], cls=training.LessonSettings)
+    lessons = main_job.config_from_args(args, [], cls=LessonSettings)
     options = dict(checkpoint_every=10 ** 6, lessons=lessons,
-                   task_kwargs=training.resolve_task_kwargs({}, Domain("robostrich_a1")))
+                   task_kwargs=main_job.resolve_task_kwargs({}, Domain("robostrich_a1")))
 
     def make_run(name):
         return DomainRun(plan, TINY, 0, str(tmp_path / name), **options)

@@ -14,7 +14,7 @@ pytest.importorskip("sbx")
 
 from agents.curriculum import Lesson  # noqa: E402
 from agents.robostrich import peers, peers_benchmark as bench  # noqa: E402
-from agents.robostrich import training  # noqa: E402
+from agents.robostrich import main_job  # noqa: E402
 from agents.robostrich.domains import Domain  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -23,8 +23,8 @@ TOOLS = ROOT / "tools"
 
 def tiny_spec(agent: str, way: str, plan: tuple, out) -> peers.PeerSpec:
     domain = Domain("robostrich")
-    return peers.PeerSpec(agent, way, 0, plan, training.resolve_task_kwargs({}, domain),
-                          training.resolve_layout(None, domain), "lesson2", None,
+    return peers.PeerSpec(agent, way, 0, plan, main_job.resolve_task_kwargs({}, domain),
+                          main_job.resolve_layout(None, domain), "lesson2", None,
                           eval_at=(plan[0].steps, sum(l.steps for l in plan)), num_eval_targets=1,
                           final_eval_targets=1, out=str(out))
 
@@ -55,7 +55,7 @@ def test_a_peer_goes_through_the_lessons_with_its_replay(tmp_path):
 
 def test_the_peer_actor_gives_contractions_in_the_task_range(tmp_path):
     domain = Domain("robostrich")
-    env = peers.make_env(domain, "lesson3", 0, training.resolve_task_kwargs({}, domain))
+    env = peers.make_env(domain, "lesson3", 0, main_job.resolve_task_kwargs({}, domain))
     model = peers.build_model("sac", env, 0)
     spec = env.dm_env.action_spec()
     observation, _ = env.reset(seed=0)

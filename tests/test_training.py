@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from agents import checkpoint
-from agents.robostrich import training
-from agents.curriculum import LessonSettings, TrainingInterrupted
+from agents.robostrich import main_job, training
+from agents.curriculum import LessonSettings, TrainingInterrupted, format_plan
 from agents.robostrich.runs import DEFAULT_LESSONS, DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
@@ -174,18 +174,18 @@ def test_runs_trained_in_worker_processes_equal_runs_trained_in_turn(tmp_path):
 
 def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
     args = training.build_parser().parse_args(["--paper-sac", "--batch-size", "32"])
-    config = training.config_from_args(args, ["--paper-sac", "--batch-size", "32"])
+    config = main_job.config_from_args(args, ["--paper-sac", "--batch-size", "32"])
     assert config == SACConfig.paper_sac(batch_size=32)
     assert not config.critic_layer_norm and config.her_ratio == 0 and config.init_temperature == 1.0
-    default = training.config_from_args(training.build_parser().parse_args(["--domain", "reacher"]), [])
+    default = main_job.config_from_args(training.build_parser().parse_args(["--domain", "reacher"]), [])
     assert default == SACConfig()  # the CLI's defaults are the dataclass's, under the main job's on robostrich
-    arm = training.config_from_args(training.build_parser().parse_args([]), [], LessonSettings)
-    assert arm == dataclasses.replace(DEFAULT_LESSONS, **training.MAIN_JOB_CONFIG["robostrich"])
-    paper = training.config_from_args(args, ["--paper-sac", "--batch-size", "32"], LessonSettings)
+    arm = main_job.config_from_args(training.build_parser().parse_args([]), [], LessonSettings)
+    assert arm == dataclasses.replace(DEFAULT_LESSONS, **main_job.MAIN_JOB_CONFIG["robostrich"])
+    paper = main_job.config_from_args(args, ["--paper-sac", "--batch-size", "32"], LessonSettings)
     assert paper == LessonSettings()  # nothing per lesson
     argv = ["--her-ratio", "0.5", "--her-lessons", "lesson1,lesson2", "--hidden-sizes", "32,16"]
     args = training.build_parser().parse_args(argv)
-    config, lessons = training.config_from_args(args, argv), training.config_from_args(args, argv, LessonSettings)
+    config, lessons = main_job.config_from_args(args, argv), main_job.config_from_args(args, argv, LessonSettings)
     assert lessons.her_lessons == ("lesson1", "lesson2") and config.hidden_sizes == (32, 16)
     assert (lessons.her_ratio("lesson2", config), lessons.her_ratio("lesson3", config)) == (0.5, 0.0)
 
@@ -222,25 +222,25 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     assert [DEFAULT_LESSONS.her_ratio(t, config) for t in ("lesson1", "lesson2", "lesson3", "lesson4")] == [
         0.5, 0.0, 0.0, 0.0]
     assert not config.her_level_goals and not SACConfig.paper_sac().her_level_goals
-    assert training.resolve_layout(None, arm) == "ventral_slips" == arm.layout  # the tasks' own, by name
-    assert training.resolve_layout("antagonist_pairs", arm) == "antagonist_pairs"
-    assert training.resolve_layout(None, dmc) is None and dmc.layout is None
+    assert main_job.resolve_layout(None, arm) == "ventral_slips" == arm.layout  # the tasks' own, by name
+    assert main_job.resolve_layout("antagonist_pairs", arm) == "antagonist_pairs"
+    assert main_job.resolve_layout(None, dmc) is None and dmc.layout is None
     with pytest.raises(ValueError, match="'paper' is now called 'ventral_from_base'"):
         Domain("robostrich", "paper")
     recipe = {"weights": {"position_precision": 1.0, "attitude_precision": 0.5}, "target_sampling": "failures",
               "fixed_stored_starts": 0.25}
-    assert training.resolve_task_kwargs({}, arm) == recipe
-    assert training.resolve_task_kwargs({"weights": {"position_error": 10}, "position_tolerance": 0.02}, arm) == {
+    assert main_job.resolve_task_kwargs({}, arm) == recipe
+    assert main_job.resolve_task_kwargs({"weights": {"position_error": 10}, "position_tolerance": 0.02}, arm) == {
         **recipe, "weights": {"position_precision": 1.0, "attitude_precision": 0.5, "position_error": 10},
         "position_tolerance": 0.02}
     paper = {"weights": {"position_precision": 0, "attitude_precision": 0}, "target_sampling": "uniform",
              "fixed_stored_starts": 0}
-    assert training.resolve_task_kwargs(paper, arm) == paper
+    assert main_job.resolve_task_kwargs(paper, arm) == paper
     # the standing quadruped's arm holds the frame's stored poses: the same recipe there, and a
     # quarter of lesson 4's episodes stand
-    assert training.resolve_task_kwargs({}, Domain("robostrich_a1")) == {**recipe, "standing_share": 0.25}
-    assert training.resolve_task_kwargs({"standing_share": 0}, Domain("robostrich_a1"))["standing_share"] == 0
-    assert training.resolve_task_kwargs({}, dmc) == {}
+    assert main_job.resolve_task_kwargs({}, Domain("robostrich_a1")) == {**recipe, "standing_share": 0.25}
+    assert main_job.resolve_task_kwargs({"standing_share": 0}, Domain("robostrich_a1"))["standing_share"] == 0
+    assert main_job.resolve_task_kwargs({}, dmc) == {}
     with pytest.raises(ValueError, match="target_entropy_per_action"):
         SACConfig(target_entropy_per_action=float("nan"))
 
@@ -251,8 +251,8 @@ def test_main_job_on_the_arm_gives_lesson_3_the_longest_share_and_narrower_noise
     given wins, --paper-sac and other domains keep theirs."""
     def made(*argv):
         args = training.build_parser().parse_args(list(argv))
-        return (training.format_plan(training.plan_from_args(args)), training.config_from_args(args, list(argv)),
-                training.config_from_args(args, list(argv), LessonSettings))
+        return (format_plan(main_job.plan_from_args(args)), main_job.config_from_args(args, list(argv)),
+                main_job.config_from_args(args, list(argv), LessonSettings))
 
     plan, config, lessons = made()
     assert plan == "robostrich/lesson1:160000,robostrich/lesson2:160000,robostrich/lesson3:280000"

@@ -47,7 +47,7 @@ def curriculum_success(case, target_path: pathlib.Path, options, steps: int = DE
     """A short curriculum (lessons 1-3 in equal parts, ``robostrich-train``'s learner and
     defaults) on the case's own training targets, then its held-out success."""
     from agents.robostrich.runs import DomainRun, make_environment, parse_plan
-    from agents.robostrich.training import FIXED_START_ARM_TASK_KWARGS
+    from agents.robostrich.main_job import FIXED_START_ARM_TASK_KWARGS
     from agents.sac.builder import SACBuilder
     from agents.sac.config import SACConfig
     if not _has_targets(target_path) or not len(targets.heldout_targets(target_path)) \

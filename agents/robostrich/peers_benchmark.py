@@ -14,8 +14,8 @@ from typing import Optional
 
 import numpy as np
 
-from agents.curriculum import Lesson
-from agents.robostrich import evaluation, peers
+from agents.curriculum import Lesson, read_records
+from agents.robostrich import evaluation, main_job, peers, training
 from agents.robostrich.domains import Domain
 
 DOMAIN = "robostrich"
@@ -41,11 +41,10 @@ class Settings:
 
 def lesson_plan(way: str, steps: int) -> tuple:
     """The main job's lessons and shares at ``steps`` ('lessons'), or its final lesson alone ('final')."""
-    from agents.robostrich.training import MAIN_JOB_LESSON_SHARES
     tasks = Domain(DOMAIN).curriculum()
     if way == "final":
         return (Lesson(DOMAIN, tasks[-1], steps),)
-    shares = MAIN_JOB_LESSON_SHARES[DOMAIN]
+    shares = main_job.MAIN_JOB_LESSON_SHARES[DOMAIN]
     parts = [steps * share // sum(shares) for share in shares[:-1]]
     return tuple(Lesson(DOMAIN, t, s) for t, s in zip(tasks, parts + [steps - sum(parts)]))
 
@@ -61,11 +60,10 @@ def job_labels(settings: Settings) -> list:
 
 
 def peer_spec(settings: Settings, label: str, seed: int) -> peers.PeerSpec:
-    from agents.robostrich import training
     agent, way = label.rsplit("_", 1)
     domain = Domain(DOMAIN)
     return peers.PeerSpec(agent, way, seed, lesson_plan(way, settings.steps),
-                          training.resolve_task_kwargs({}, domain), training.resolve_layout(None, domain),
+                          main_job.resolve_task_kwargs({}, domain), main_job.resolve_layout(None, domain),
                           domain.heldout_task("lesson3"), settings.track_task, eval_points(settings),
                           settings.num_eval_targets, settings.final_eval_targets, job_dir(settings, label, seed))
 
@@ -92,11 +90,10 @@ def compact(summary: dict) -> dict:
 
 def run_ours(settings: Settings, label: str, seed: int) -> dict:
     """Our run through robostrich-train (its lookup evaluation too); its result as a peer's."""
-    from agents.robostrich import training
     out = job_dir(settings, label, seed)
     with open(os.path.join(out, "train.log"), "w") as log, contextlib.redirect_stdout(log):
         summary = training.main(ours_argv(settings, label, seed))
-    curve = training.read_jsonl(os.path.join(out, "curriculum", "evals.jsonl"))
+    curve = read_records(os.path.join(out, "curriculum", "evals.jsonl"))
     return {"env_steps": summary["env_steps"]["curriculum"],
             "train_seconds": summary["timings"]["curriculum"]["seconds"],
             "curve": [{"env_steps": r["env_steps"], "summary": r["summary"]} for r in curve],

@@ -16,7 +16,7 @@ import os
 import sys
 
 from agents.robostrich import directory_lock, sweep_grid, sweep_ray, sweep_table
-from agents.robostrich import training  # robostrich-train's own parser checks every group's flags
+from agents.robostrich import training, training_input  # robostrich-train's own parser and checks, for every group's flags
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs, parsing
 from robostrich_suite.files import write_text
@@ -88,7 +88,7 @@ def check_training_flags(group) -> None:
     argv = list(group.arguments)
     args = parser.parse_args(argv)
     try:
-        training.prepare(args, argv)
+        training_input.prepare(args, argv)
     except (ValueError, TypeError) as error:
         refuse(str(error))
 

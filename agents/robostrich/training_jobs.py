@@ -1,0 +1,148 @@
+"""What each of robostrich-train's runs is given and does: the run's description (picklable,
+for a worker), its periodic and final evaluations, and the lookup's evaluation as a job of its own."""
+import dataclasses
+import json
+import os
+import time
+from typing import Optional
+
+import numpy as np
+
+from agents.curriculum import LessonSettings, read_records
+from agents.robostrich import evaluation, transfer
+from agents.robostrich.domains import Domain
+from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
+from agents.robostrich.runs import DEFAULT_LESSONS, DomainRun
+from agents.sac.builder import SACBuilder
+from agents.sac.config import SACConfig
+from robostrich_suite import cli as cli_lib
+from robostrich_suite import files
+
+
+def read_jsonl(path):
+    """The records of a run's metrics.jsonl or evals.jsonl (agents.curriculum.read_records)."""
+    return read_records(path)
+
+
+@dataclasses.dataclass(frozen=True)
+class RunJob:
+    """What a run does besides training: periodic and final evaluation (picklable, for a worker)."""
+
+    domain: Domain
+    heldout_task: str
+    track_task: Optional[str]
+    eval_at: tuple
+    num_eval_targets: int
+    final_eval_targets: Optional[int]
+    out_eval: str
+    record: bool
+    stop_at_step: Optional[int] = None
+
+
+@dataclasses.dataclass(frozen=True)
+class RunSpec:
+    """Everything a DomainRun is built from (picklable): the parent process of a parallel
+    job passes it to a worker instead of building the run (networks, replay, environment)
+    itself, which it would only throw away."""
+
+    label: str
+    plan: tuple
+    config: SACConfig
+    seed: int
+    run_dir: str
+    checkpoint_every: int
+    task_kwargs: Optional[dict]
+    layout: Optional[str]
+    lessons: LessonSettings = DEFAULT_LESSONS
+    residual_scale: float = 0.0
+    init_from: Optional[str] = None  # a checkpoint to start a fresh run's learner from (agents/robostrich/transfer.py)
+    init_digest: Optional[str] = None  # its content hash, kept in the run's fingerprint
+    keep_lesson_checkpoints: bool = False  # also a checkpoint after every lesson but the last
+
+    @property
+    def total_steps(self) -> int:
+        return sum(l.steps for l in self.plan)
+
+    def build(self, restore: bool) -> DomainRun:
+        """The run; restored from its checkpoint when ``restore`` and one exists (raises on a
+        damaged or mismatched checkpoint, never restarts silently)."""
+        run = DomainRun(list(self.plan), self.config, self.seed, self.run_dir,
+                        checkpoint_every=self.checkpoint_every, name=self.label,
+                        task_kwargs=self.task_kwargs, layout=self.layout, init_from=self.init_digest,
+                        keep_lesson_checkpoints=self.keep_lesson_checkpoints, lessons=self.lessons,
+                        residual_scale=self.residual_scale)
+        if restore and os.path.exists(run.checkpoint_path):
+            run.restore()
+        elif self.init_from is not None:
+            transfer.initialize(run, self.init_from, self.init_digest)
+        return run
+
+
+@dataclasses.dataclass(frozen=True)
+class LookupSpec:
+    """The no-learning lookup's final evaluation as a job of its own: in a parallel job it takes the
+    core the first finished run frees instead of running alone after both."""
+
+    label: str = LOOKUP_LABEL
+    total_steps: int = 0
+
+    def evaluate(self, job: RunJob, progress=None) -> Optional[dict]:
+        return evaluation.evaluate_lookup(job.out_eval, job.domain, job.heldout_task, job.track_task,
+                                          job.final_eval_targets, record=job.record,
+                                          on_episode=progress.evaluated if progress is not None else None)
+
+
+def final_targets(job: RunJob) -> Optional[int]:
+    """Held-out targets of a final (or end-of-lesson) evaluation: all of the arm's unless
+    --final-eval-targets says; off the arm as many seeded episodes as the periodic ones."""
+    return job.final_eval_targets or (None if job.domain.is_arm else job.num_eval_targets)
+
+
+def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
+    """Finish `run`'s plan (periodic held-out evaluations in its evals.jsonl), then its final
+    evaluation (JSON reports in job.out_eval). Returns the reports and the run's counters."""
+    config = run.config
+    timing = None
+    if not run.done:
+        if progress is not None:
+            progress.reset_window()
+
+        def on_eval(r):
+            actor = SACBuilder.make_eval_actor(r.loop)
+            lesson_end = r.loop.env_steps in step_boundaries(r.plan)[:-1]  # evaluated on every held-out target
+            targets = final_targets(job) if lesson_end else job.num_eval_targets
+            report = evaluation.evaluate_heldout(actor, r.loop.flattener, job.domain, job.heldout_task,
+                                                 targets, action_repeat=config.action_repeat)
+            record = {"env_steps": r.loop.env_steps, "lessons_completed": r.lesson_index, "summary": report["summary"]}
+            if lesson_end:
+                record["lesson_end"] = True
+            with open(r.evals_path, "a") as f:
+                f.write(json.dumps(record) + "\n")
+
+        start, start_steps = time.time(), run.loop.env_steps
+        with files.naming(run.run_dir, only_unnamed=True), cli_lib.deferred_interrupts():
+            # Ctrl-C: a checkpoint between chunks, then KeyboardInterrupt; a failed write of the
+            # run's records (a full disk) names where the run writes
+            run.run(progress=progress, on_eval=on_eval, eval_at=job.eval_at, stop_at_step=job.stop_at_step,
+                    stop_requested=cli_lib.interrupted)
+        timing = {"seconds": time.time() - start, "env_steps": run.loop.env_steps - start_steps,
+                  "updates": run.loop.learner.num_updates}
+    reports = evaluation.evaluate_agent(SACBuilder.make_eval_actor(run.loop), run.loop.flattener, job.out_eval,
+                                        run.name, job.domain, job.heldout_task, job.track_task, final_targets(job),
+                                        env_steps=run.loop.env_steps, record=job.record,
+                                        action_repeat=config.action_repeat,
+                                        on_episode=progress.evaluated if progress is not None else None)
+    return {"reports": reports, "env_steps": run.loop.env_steps, "updates": run.loop.learner.num_updates,
+            "timing": timing}
+
+
+def step_boundaries(plan) -> list:
+    return list(np.cumsum([l.steps for l in plan]))
+
+
+def lesson_end_evaluations(records: list, plan) -> dict:
+    """``{"heldout_after_lessonK": summary}``: the evaluation on every held-out target at the end of
+    each lesson of ``plan`` but the last, from the run's evals.jsonl (the last record of each)."""
+    names = {int(end): f"heldout_after_{lesson.task}" for end, lesson in zip(step_boundaries(plan)[:-1], plan)}
+    return {names[r["env_steps"]]: r["summary"] for r in records
+            if r.get("lesson_end") and r["env_steps"] in names}
