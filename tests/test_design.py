@@ -217,6 +217,9 @@ def test_a_search_beyond_the_family_writes_routings_of_the_asked_tendons_that_lo
                            *TINY])
     (row,) = summary["front"]  # the slips pass the rolling/lever test
     assert summary["tendons"] == {"dorsal": 1, "ventral": 4, "max_hole_stride": 2}
+    record = results_page.make_record("design", str(out / "design.json"), "Beyond", date="2026-12-05")
+    assert "beyond the paper's family: 1 dorsal and 4 ventral tendons, holes up to 2 links apart" in \
+        results_page.render_record(record)
     name, layout = layouts.read_file(row["layout_file"])
     assert [t.side for t in layout.tendons] == ["dorsal"] + ["ventral"] * 4
     assert layout.tendons[1].links == ("c18", "c16", "c14")  # holes every other link, origin to insertion

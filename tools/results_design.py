@@ -28,6 +28,17 @@ def scoring(data: dict) -> str:
     return f"; scored by coverage and {what}, the slot {where}"
 
 
+def family(data: dict) -> str:
+    """The tendons of the study's routings when beyond the paper's family (1 dorsal, 8 ventral, every
+    link holed); nothing for the paper's or for records before the flags existed."""
+    tendons = data.get("tendons") or {"dorsal": 1, "ventral": 8, "max_hole_stride": 1}
+    if tendons == {"dorsal": 1, "ventral": 8, "max_hole_stride": 1}:
+        return ""
+    skip = (f", holes up to {tendons['max_hole_stride']} links apart" if tendons["max_hole_stride"] > 1
+            else ", every link holed")
+    return f"; beyond the paper's family: {tendons['dorsal']} dorsal and {tendons['ventral']} ventral tendons{skip}"
+
+
 def caption(data: dict) -> str:
     trials, need = data["trials"], data["need"]
     rate = (f", {trials['trials_per_core_hour']:g} trials per hour of one core ({trials['trials_per_hour']:g} "
@@ -35,7 +46,7 @@ def caption(data: dict) -> str:
     return (f"{trials['complete']} routings ({trials['feasible']} with rolling/lever <= {data['ratio_limit']:g}) at "
             f"{data['pose_budget']} sought poses each{rate}; best gap column "
             f"{100 * data['best_feasible_gap_column_m']:.1f} cm ({100 * data['best_gap_column_m']:.1f} cm of any routing), "
-            f"the narrow gap needs {100 * need['column_height_m']:.0f} cm above its shelf{scoring(data)}")
+            f"the narrow gap needs {100 * need['column_height_m']:.0f} cm above its shelf{scoring(data)}{family(data)}")
 
 
 def _percent(value) -> str:
