@@ -27,6 +27,7 @@ setup(
         "rerun-sdk==0.41.0",
         "matplotlib==3.11.2",  # figures (PNG) for the paper's plots
         "tqdm==4.70.1",  # progress bars on training and sampling
+        "scipy==1.17.1",  # gap_bound's least_squares over the joint angles (jax already installs it)
     ],
     extras_require={
         # ray: the sweep's tests start a local Ray, and CI installs only this extra
