@@ -25,9 +25,10 @@ def test_over_the_mount_the_links_hold_a_column_and_out_of_reach_none():
 
 
 def test_a_survey_writes_its_numbers_and_figure(tmp_path):
-    rows = gap_bound.survey([0.0, 0.9], [], starts=3, steps=1, pushed=1)
+    rows = gap_bound.survey([0.0, 0.9], [], starts=3, steps=1, pushed=1, task_starts=2)
     result = gap_bound.summary(rows, "test")
     assert result["slots"][0]["column_height_m"] > 0 and result["slots"][1]["column_height_m"] is None
+    assert result["task_slot"]["starts"] == 2 and result["task_slot"]["slot_x_m"] == gap_column.TASK_NEED["slot_x_m"]
     assert result["farthest_slot_pushed_m"] >= 0.0 and result["need"] == gap_column.TASK_NEED
     assert 0.0 < result["forward_curl"]["passes_shelf_height_at_x_m"] < result["forward_curl"]["highest_point_m"][0]
     json.dumps(result)  # no poses, only numbers

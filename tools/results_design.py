@@ -22,9 +22,11 @@ def scoring(data: dict) -> str:
         return ""
     slot = data.get("slot_x")
     where = "anywhere" if slot is None else f"{100 * slot[0]:.0f} to {100 * slot[1]:.0f} cm ahead of the base joint"
-    what = ("the way in from under the shelf (how far up through the slot the head gets; best feasible "
-            f"{100 * data['best_feasible_passage_m']:+.1f} cm from the shelf's top)"
-            if data["gap_objective"] == "passage" else "the gap column")
+    if data["gap_objective"] != "passage":
+        return f"; scored by coverage and the gap column, the slot {where}"
+    best = ("no routing feasible" if not data["trials"]["feasible"] else
+            f"best feasible {100 * data['best_feasible_passage_m']:+.1f} cm from the shelf's top")
+    what = f"the way in from under the shelf (how far up through the slot the head gets; {best})"
     return f"; scored by coverage and {what}, the slot {where}"
 
 

@@ -46,6 +46,7 @@ MISS_STARTS = 16  # starts sought with the scene ignored, for the nearest miss o
 MAX_STEPS = 60  # column heights stepped above and below a pose found: 0.6 m, more than the links reach
 PUSHED_SEEDS = 8  # poses of the farthest slot with a column pushed forward from
 STARTS = 48  # random starts per slot position
+TASK_STARTS = 1000  # random starts at the task's slot itself, the question that matters most
 SLOTS = tuple(np.round(np.arange(0.20, 0.501, 0.02), 3))  # m: slot centres tried, the task's range
 SEED = 0
 
@@ -221,10 +222,11 @@ def forward_curl(arm: Arm, shelf_z: float) -> dict:
 
 
 def survey(slots, shelves, starts: int = STARTS, seed: int = SEED, spec=None, progress=None,
-           steps: int = MAX_STEPS, pushed: int = PUSHED_SEEDS) -> dict:
+           steps: int = MAX_STEPS, pushed: int = PUSHED_SEEDS, task_starts: int = TASK_STARTS) -> dict:
     """:func:`column_at` at every slot centre of ``slots`` under the task's shelf, then the slot pushed
-    forward from ``pushed`` poses of the farthest columns (:func:`push_forward`), and the task's slot
-    under every shelf height of ``shelves`` (m above the base joint): what a scene change buys."""
+    forward from ``pushed`` poses of the farthest columns (:func:`push_forward`), the task's slot
+    under every shelf height of ``shelves`` (m above the base joint): what a scene change buys; last
+    the task's slot and shelf from ``task_starts`` starts (0: none)."""
     arm, rng = Arm(spec), np.random.default_rng(seed)
     progress = progress or (lambda: None)
     rows = {"slots": [], "shelves": [], "forward_curl": forward_curl(arm, gap_column.SHELF_Z)}
@@ -238,7 +240,16 @@ def survey(slots, shelves, starts: int = STARTS, seed: int = SEED, spec=None, pr
         rows["shelves"].append(column_at(arm, gap_column.TASK_NEED["slot_x_m"], z, arm.random_angles(rng, starts),
                                          steps))
         progress()
+    if task_starts:
+        rows["task"] = column_at(arm, gap_column.TASK_NEED["slot_x_m"], gap_column.SHELF_Z,
+                                 arm.random_angles(rng, task_starts), steps)
     return rows
+
+
+def task_row(rows: dict) -> dict:
+    """The task's slot under its shelf: its own many-start row, else the nearest slot of the survey."""
+    x = gap_column.TASK_NEED["slot_x_m"]
+    return rows.get("task") or min(rows["slots"], key=lambda r: abs(r["slot_x_m"] - x))
 
 
 def summary(rows: dict, command: str) -> dict:
@@ -246,10 +257,10 @@ def summary(rows: dict, command: str) -> dict:
     def strip(row):
         return {k: v for k, v in row.items() if k not in ("poses", "nearest", "seeds")}
     need = gap_column.TASK_NEED
-    task = min(rows["slots"], key=lambda r: abs(r["slot_x_m"] - need["slot_x_m"]))
+    task = task_row(rows)
     forward = [r for r in rows["slots"] if (r["column_height_m"] or 0.0) >= need["column_height_m"]]
     in_range = [r for r in rows["slots"] if 0.2 - 1e-9 <= r["slot_x_m"] <= 0.5 + 1e-9]
-    return {"command": command, "need": need, "starts_per_slot": task["starts"],
+    return {"command": command, "need": need, "starts_per_slot": rows["slots"][0]["starts"],
             "task_slot": strip(task),
             "best_in_task_range_m": max((r["column_height_m"] or 0.0) for r in in_range) if in_range else None,
             "farthest_slot_with_needed_column_m": max((r["slot_x_m"] for r in forward), default=None),
@@ -305,12 +316,13 @@ def plot(rows: dict, result: dict, path) -> None:
             _draw_pose(axes[1], pose, color, f"head {pose.head[1]:.3f} m up")
         axes[1].set_title(f"the farthest slot forward with a column: {row['slot_x_m']:.2f} m, "
                           f"{100 * row['column_height_m']:.1f} cm (lowest, highest pose)", fontsize=9)
-    task_row = min(rows["slots"], key=lambda r: abs(r["slot_x_m"] - need["slot_x_m"]))
-    _draw_scene(axes[2], gap_column.Scene(task_row["slot_x_m"], task_row["shelf_z_m"]))
-    _draw_pose(axes[2], task_row["nearest"], "C3", "nearest pose found: head level over the slot")
+    task = task_row(rows)
+    _draw_scene(axes[2], gap_column.Scene(task["slot_x_m"], task["shelf_z_m"]))
+    _draw_pose(axes[2], task["nearest"], "C3", "nearest pose found: head level over the slot")
     axes[2].plot([need["slot_x_m"]] * 2, need["heads_z_m"], "rX", ms=9, ls="", label="the task's sub-targets 5 and 6")
-    miss_text = "" if task_row["least_miss_m"] is None else f", the neck {100 * task_row['least_miss_m']:.0f} cm off the slot"
-    axes[2].set_title(f"the task's slot ({task_row['slot_x_m']:.2f} m): no pose threads it{miss_text}", fontsize=9)
+    miss_text = "" if task["least_miss_m"] is None else f"; the neck {100 * task['least_miss_m']:.0f} cm off it"
+    found = "none threads it" if not task["seeds_found"] else f"{task['seeds_found']} thread it"
+    axes[2].set_title(f"task's slot {task['slot_x_m']:.2f} m, {task['starts']} starts: {found}{miss_text}", fontsize=9)
     for ax in axes[1:]:
         ax.plot(0, 0, "ks", ms=6)
         ax.set_xlim(-0.25, 0.65)
@@ -332,6 +344,8 @@ def main(argv=None) -> dict:
                                      description=__doc__.splitlines()[0], allow_abbrev=False)
     parser.add_argument("--starts", type=cli_lib.whole_number(1, 10_000), default=STARTS,
                         help="random starts per slot position (default: %(default)s)")
+    parser.add_argument("--task-starts", type=cli_lib.whole_number(0, 100_000), default=TASK_STARTS,
+                        help="random starts at the task's slot itself (default: %(default)s)")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("docs"),
                         help="directory for gap_bound.png and gap_bound.json (default: %(default)s)")
     args = parser.parse_args(argv)
@@ -339,7 +353,7 @@ def main(argv=None) -> dict:
     slots = np.round(np.arange(-0.10, 0.501, 0.02), 3)
     shelves = np.round(np.arange(gap_column.SHELF_Z, 0.40, 0.05), 3)
     with tqdm(total=len(slots) + len(shelves), desc="slots", unit="slot") as bar:
-        rows = survey(slots, shelves, args.starts, progress=bar.update)
+        rows = survey(slots, shelves, args.starts, progress=bar.update, task_starts=args.task_starts)
     command = " ".join(["python -m robostrich_suite.studies.gap_bound", *(argv or [])])
     result = summary(rows, command)
     args.out.mkdir(parents=True, exist_ok=True)
