@@ -9,6 +9,12 @@ task says where the goal sits in its observation (``GOAL_OBSERVATION``,
 holds more components than the goal, names those the goal is compared with) and gives the
 reward with ``goal_reward``; the agent never looks at the system itself.
 
+A reward may also hold a part that does not depend on the goal (the arm's charge for changing its
+inputs): where the task says so (``has_goal_free_reward``), the replay keeps that part of each
+stored reward (the reward less what ``goal_reward`` gives for the transition's own goal) and adds it
+to every reward it recomputes, so the charge survives hindsight goals and the curriculum's reward
+recomputation.
+
 Under an action repeat a transition spans several control steps whose rewards
 are summed, so the replay keeps the achieved position and attitude error after
 each of them (``substep_goals``) and sums the recomputed rewards the same way.
@@ -33,6 +39,8 @@ class GoalRelabeler:
         # None: every reached position is one.
         tolerance = getattr(task, "goal_attitude_tolerance", None)
         self.goal_attitude_tolerance = tolerance() if callable(tolerance) else None
+        goal_free = getattr(task, "has_goal_free_reward", None)
+        self.keeps_goal_free = bool(goal_free()) if callable(goal_free) else False
 
     @classmethod
     def for_environment(cls, env, flattener) -> Optional["GoalRelabeler"]:
@@ -78,6 +86,14 @@ class GoalRelabeler:
         per_step = self.reward_fn(substep_goals[..., :g], substep_goals[..., g], goal[..., None, :])
         taken = np.arange(substep_goals.shape[-2]) < substeps[..., None]
         return np.sum(np.where(taken, per_step, 0.0), axis=-1)
+
+
+    def goal_free(self, reward: float, substep_goals, flat_obs: np.ndarray) -> float:
+        """The part of ``reward`` that ``goal_reward`` does not give: the stored reward of a
+        transition from ``flat_obs`` whose control steps reached ``substep_goals``, less its goal's."""
+        reached = np.asarray(substep_goals, np.float64)[None]
+        goal_part = self.rewards(reached, np.array([len(reached[0])]), np.asarray(flat_obs[self.goal], np.float64)[None])
+        return float(reward - goal_part[0])
 
 
 def _achieved_index(task, achieved: slice):

@@ -103,7 +103,9 @@ class EnvironmentLoop:
                 next_obs = flatten(timestep.observation)
                 if substeps is not None:
                     substeps.append(relabeler.substep(next_obs))
-            replay.add(obs, policy_action, reward, discount, next_obs, substeps)
+            goal_free = (relabeler.goal_free(reward, substeps, obs)
+                         if relabeler is not None and relabeler.keeps_goal_free else None)
+            replay.add(obs, policy_action, reward, discount, next_obs, substeps, goal_free)
             self.timestep, self._obs = timestep, next_obs
             self.episode_return += reward
             self.episode_length += taken

@@ -59,6 +59,7 @@ class ReplayBuffer:
             self.substeps = np.zeros((capacity,), np.int32)
             self.abs_index = np.zeros((capacity,), np.int64)  # position in the stream of all additions
             self.episode_last = np.zeros((capacity,), np.int64)  # abs index of its episode's end; -1 open
+        self.goal_free = None  # (capacity,) once a transition comes with a goal-free reward part
         self.size = 0
         self.insert_index = 0
         self.total_added = 0
@@ -73,8 +74,9 @@ class ReplayBuffer:
     def fields(self):
         return self.FIELDS + (self.GOAL_FIELDS if self.goal_width else ())
 
-    def add(self, obs, action, reward, discount, next_obs, substep_goals=None):
-        """One transition; ``substep_goals`` (taken control steps, goal_width) when goals are kept."""
+    def add(self, obs, action, reward, discount, next_obs, substep_goals=None, goal_free=None):
+        """One transition; ``substep_goals`` (taken control steps, goal_width) when goals are kept;
+        ``goal_free``: the part of ``reward`` a recomputed reward keeps (agents/goals.py)."""
         i = self.insert_index
         self.obs[i] = obs
         self.action[i] = action
@@ -87,6 +89,10 @@ class ReplayBuffer:
             self.substeps[i] = taken
             self.abs_index[i] = self.total_added
             self.episode_last[i] = -1
+        if goal_free is not None and self.goal_free is None:
+            self.goal_free = np.zeros((self.capacity,), np.float32)
+        if self.goal_free is not None:
+            self.goal_free[i] = 0.0 if goal_free is None else goal_free
         self.insert_index = (i + 1) % self.capacity
         self.size = min(self.size + 1, self.capacity)
         self.total_added += 1
@@ -147,6 +153,8 @@ class ReplayBuffer:
         recompute &= discount > 0
         if np.any(recompute):
             new = relabeler.rewards(self.substep_goals[idx], self.substeps[idx], goal)
+            if self.goal_free is not None:
+                new = new + self.goal_free[idx]
             reward = np.where(recompute, new, reward).astype(np.float32)
         return Transitions(obs, action, reward, discount, next_obs)
 
@@ -159,7 +167,8 @@ class ReplayBuffer:
                 "goal_width": self.goal_width, "repeat": self.repeat,
                 "size": n, "insert_index": self.insert_index, "rng": self.rng.bit_generator.state,
                 "total_added": self.total_added, "episode_start": self.episode_start, "row_base": self.row_base,
-                **{f: getattr(self, f)[:n] for f in self.fields}}
+                **{f: getattr(self, f)[:n] for f in self.fields},
+                **({} if self.goal_free is None else {"goal_free": self.goal_free[:n]})}
 
     def load_state_dict(self, d: dict):
         for k in ("capacity", "obs_size", "action_size", "goal_width", "repeat"):
@@ -168,6 +177,9 @@ class ReplayBuffer:
         n = d["size"]
         for f in self.fields:
             getattr(self, f)[:n] = d[f]
+        if "goal_free" in d:
+            self.goal_free = np.zeros((self.capacity,), np.float32)
+            self.goal_free[:n] = d["goal_free"]
         self.size = n
         self.insert_index = d["insert_index"]
         self.total_added = d.get("total_added", n)

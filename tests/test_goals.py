@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from agents.curriculum import LessonSettings, TrainingInterrupted
+from agents.replay import ReplayBuffer
 from agents.robostrich.runs import DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
@@ -36,6 +37,38 @@ def test_recomputed_rewards_equal_the_rewards_the_task_gave(run):
     np.testing.assert_allclose(recomputed, replay.reward[:n], rtol=1e-5, atol=1e-4)
     assert np.all(replay.substeps[:n] == 5)
     assert np.min(replay.reward[:n]) < -5  # real misses, not a vacuous comparison
+
+
+def test_the_inputs_change_charge_survives_recomputed_and_hindsight_rewards(tmp_path):
+    """With ``weights.action_change`` the replay keeps each reward's part no goal changes: recomputed
+    for its own goal the reward is the one the task gave (the charge included), and a hindsight
+    reward carries the same charge; lesson 1 (eq. 9, no charge) keeps none."""
+    run = DomainRun(parse_plan("robostrich/lesson1:300,robostrich/lesson2:600"), HER, seed=1, run_dir=str(tmp_path),
+                    checkpoint_every=10_000, task_kwargs={"weights": {"action_change": 50.0}})
+    run.run()
+    replay, relabeler = run.loop.replay, run.loop.relabeler
+    assert relabeler.keeps_goal_free and replay.goal_free is not None
+    n, lesson1 = len(replay), 300 // 5
+    charge = replay.goal_free[:n]
+    assert np.all(charge[:lesson1] == 0) and np.all(charge[lesson1:] < 0)  # every lesson-2 step moved its inputs
+    goals = replay.obs[:n, relabeler.goal]
+    recomputed = relabeler.rewards(replay.substep_goals[:n], replay.substeps[:n], goals) + charge
+    np.testing.assert_allclose(recomputed[lesson1:], replay.reward[lesson1:n], rtol=1e-5, atol=1e-4)
+    plain = relabeler.rewards(replay.substep_goals[:n], replay.substeps[:n], goals)
+    assert np.max(plain[lesson1:] - replay.reward[lesson1:n]) > 0.1  # without the kept part it would be lost
+    drawn = replay.rng.bit_generator.state
+    batch = replay.sample_stack(1, 256, relabeler, her_ratio=1.0, relabel_rewards=True)
+    replay.rng.bit_generator.state = drawn
+    idx = replay.rng.integers(0, n, size=(1, 256))  # the rows that batch drew
+    new_goal = batch.obs[..., relabeler.goal]
+    assert np.mean(np.any(new_goal != replay.obs[idx][..., relabeler.goal], axis=-1)) > 0.5  # relabelled
+    plain = relabeler.rewards(replay.substep_goals[idx], replay.substeps[idx], new_goal)
+    np.testing.assert_allclose(batch.reward - plain, charge[idx], atol=1e-4)
+    state = replay.state_dict()
+    restored = ReplayBuffer(state["obs_size"], state["action_size"], state["capacity"], goal_width=state["goal_width"],
+                            repeat=state["repeat"])
+    restored.load_state_dict(state)  # a checkpoint keeps the charges
+    np.testing.assert_array_equal(restored.goal_free[:n], charge)
 
 
 def test_hindsight_goals_are_reached_later_in_the_same_episode(run):

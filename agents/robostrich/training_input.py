@@ -77,10 +77,11 @@ def check_residual_scale(scale: float, config: SACConfig) -> float:
 
 
 def check_goal_free_terms(task_kwargs: dict, config: SACConfig) -> None:
-    """The reward's action-change and head-speed terms do not depend on the goal: rewards the replay
-    recomputes for goals (hindsight, ``relabel_rewards``) would silently drop them, so they need both off."""
+    """The reward's head-speed term depends on the goal in a way ``goal_reward`` does not compute:
+    rewards the replay recomputes for goals (hindsight, ``relabel_rewards``) would silently drop it,
+    so it needs both off. (The action-change term no goal changes: the replay keeps it.)"""
     weights = task_kwargs.get("weights")
-    for term in ("action_change", "head_vertical_speed"):
+    for term in ("head_vertical_speed",):
         weight = weights.get(term, 0) if isinstance(weights, dict) else getattr(weights, term, 0)
         if weight and (config.relabel_rewards or config.her_ratio > 0):
             raise ValueError(f"--task-kwargs weights.{term} needs the replay to keep the rewards the task "

@@ -355,6 +355,11 @@ class Reach(base.Task):
         in lesson 1 (eq. 9 ignores the attitude, so every reached position is one)."""
         return None if self.reward_name == "lesson1" else self.attitude_tolerance
 
+    def has_goal_free_reward(self) -> bool:
+        """Whether this task's reward holds a part no goal changes (the inputs' change charged in
+        eq. 10's lessons): the replay keeps it through hindsight goals and recomputed rewards."""
+        return self.reward_name != "lesson1" and bool(self.weights.action_change)
+
     def goal_reward(self, achieved, attitude_error_deg, goal) -> np.ndarray:
         """The reward this task gives with the head at ``achieved`` (..., 2), its attitude
         ``attitude_error_deg`` (...) off, had the target been ``goal`` (..., 2): eqs. 9-10

@@ -32,15 +32,17 @@ class RewardWeights:
     of the tendon inputs from one control step to the next in eq. 10's reward: a policy that
     shakes its inputs at the control rate (as lesson 4 taught on the quadruped:
     docs/log/quadruped.md#2026-12-01-the-distance-walked-leaves-the-observation-lesson-4-in-its-own-run)
-    pays for it.  It depends on the action, not on the goal, so replayed rewards recomputed for
-    other goals (hindsight, ``relabel_rewards``) cannot keep it: the agent refuses it with either on.
+    pays for it.  It depends on the action, not on the goal: the replay keeps it as the part of a
+    stored reward no goal changes (``Reach.has_goal_free_reward``, agents/goals.py) and adds it to
+    the rewards it recomputes for other goals (hindsight, ``relabel_rewards``).
 
     ``head_vertical_speed`` (per m/s, not in the paper; 0 by default) weighs the head's vertical
     speed in the world while the head is within the position tolerance of its target: on the
     walking quadruped, the bobbing Sec. 5.2.1 asks the arm to cancel once it holds the target
     (charged on the way there too, it taught the head not to move:
     docs/log/quadruped.md#2026-12-03-hindsight-goals-were-off-lesson-4-after-them-the-head-speed-term).
-    Like ``action_change`` the replay cannot recompute it for other goals.
+    Unlike ``action_change`` it depends on the goal (its tolerance) in a way ``goal_reward`` does not
+    compute, so the agent refuses it with hindsight goals or ``relabel_rewards`` on.
     """
     position_miss: float = 1.0
     attitude_miss: float = 1.0
