@@ -137,10 +137,6 @@ def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, lessons: 
             "plan": format_plan(plan), "seed": seed, **(extra or {})}
 
 
-class TrainingInterrupted(RuntimeError):
-    """Raised by `stop_at_step` to imitate a killed process in tests."""
-
-
 def run_files(run_dir: str) -> Tuple[str, str, str]:
     """A run directory's checkpoint, per-episode metrics and periodic evaluations."""
     return (os.path.join(run_dir, checkpoint.FILE_NAME), os.path.join(run_dir, "metrics.jsonl"),
@@ -315,12 +311,13 @@ class CurriculumRun:
 
     # -- Algorithm 1 -----------------------------------------------------------------------
     def run(self, progress=None, on_eval: Optional[Callable] = None, eval_at: Sequence[int] = (),
-            stop_at_step: Optional[int] = None, chunk: int = 500, stop_requested: Callable[[], bool] = lambda: False):
-        """Run the remaining plan. `on_eval(run)` is called when env_steps hits a value in eval_at.
+            until_step: Optional[int] = None, chunk: int = 500, stop_requested: Callable[[], bool] = lambda: False):
+        """Run the remaining plan, or only until ``until_step`` control steps (then return, the
+        run not done: a step budget). `on_eval(run)` is called when env_steps hits a value in eval_at.
         When `stop_requested()` turns true (polled between chunks: a Ctrl-C handler's flag, say) a
         checkpoint is written, then KeyboardInterrupt raised.
         An episode a lesson's end cuts off gets its metrics line too (``"cut": true``)."""
-        self._run(progress, on_eval, eval_at, stop_at_step, chunk, stop_requested)
+        self._run(progress, on_eval, eval_at, until_step, chunk, stop_requested)
 
     def _stop_if_interrupted(self, metrics_file, stop_requested):
         if stop_requested():
@@ -328,7 +325,7 @@ class CurriculumRun:
             self.save_checkpoint()
             raise KeyboardInterrupt(f"checkpoint written at step {self.loop.env_steps}: {self.checkpoint_path}")
 
-    def _run(self, progress, on_eval, eval_at, stop_at_step, chunk, stop_requested):
+    def _run(self, progress, on_eval, eval_at, until_step, chunk, stop_requested):
         loop = self.loop
         eval_at = sorted(set(int(s) for s in eval_at))
         metrics_file = open(self.metrics_path, "a")
@@ -352,10 +349,10 @@ class CurriculumRun:
                 upcoming = [s for s in eval_at if s > loop.env_steps]
                 if upcoming:
                     n = min(n, upcoming[0] - loop.env_steps)
-                if stop_at_step is not None:
-                    if loop.env_steps >= stop_at_step:
-                        raise TrainingInterrupted(f"stopped at step {loop.env_steps}")
-                    n = min(n, stop_at_step - loop.env_steps)
+                if until_step is not None:
+                    if loop.env_steps >= until_step:
+                        return
+                    n = min(n, until_step - loop.env_steps)
                 before = loop.env_steps
                 ran = loop.run(n, on_episode=on_episode)
                 self.lesson_steps += ran

@@ -5,7 +5,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from agents.curriculum import LessonSettings, TrainingInterrupted
+from agents.curriculum import LessonSettings
 from agents.replay import ReplayBuffer
 from agents.robostrich.runs import DomainRun, parse_plan
 from agents.sac.config import SACConfig
@@ -96,8 +96,7 @@ def test_hindsight_goals_are_reached_later_in_the_same_episode(run):
 def test_resumed_her_run_is_bit_exact(tmp_path):
     plan = parse_plan("robostrich/lesson1:600,robostrich/lesson2:600")
     a = DomainRun(plan, HER, seed=3, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
-    with pytest.raises(TrainingInterrupted):
-        a.run(stop_at_step=740)  # mid-episode in lesson 2, after learning started
+    a.run(until_step=740)  # mid-episode in lesson 2, after learning started
     path = str(tmp_path / "run.ckpt")
     a.save_checkpoint(path)
     b = DomainRun(plan, HER, seed=3, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
@@ -136,8 +135,7 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
     config, lessons = HER, LessonSettings(her_lessons=("lesson1",))
     run = DomainRun(plan, config, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000, lessons=lessons)
     assert run.loop.her_ratio == 0.5
-    with pytest.raises(TrainingInterrupted):
-        run.run(stop_at_step=800)
+    run.run(until_step=800)
     assert run.lesson_index == 1 and run.loop.her_ratio == 0.0
     replay, relabeler = run.loop.replay, run.loop.relabeler
     real_targets = {tuple(g) for g in replay.obs[:len(replay), relabeler.goal]}

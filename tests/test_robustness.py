@@ -10,13 +10,12 @@ import pytest
 import robostrich_suite
 from robostrich_suite import policies
 from agents import checkpoint
-from agents.curriculum import TrainingInterrupted
 from agents.robostrich import training
 from agents.robostrich.runs import DomainRun, parse_plan
 from robostrich_suite.tasks import perturbations
 from robostrich_suite.tasks.perturbations import Perturbation
 from conftest import console_script, finish, start
-from test_training import TINY, assert_same_run
+from test_training import TINY, Killed, assert_same_run, killed_after
 
 import results_page  # noqa: E402
 
@@ -159,18 +158,15 @@ def test_randomised_training_runs_and_resumes_bit_for_bit(tmp_path):
     plan = parse_plan("robostrich/lesson3:320")
     config = dataclasses.replace(TINY, min_replay_size=100)
     a = DomainRun(plan, config, seed=2, run_dir=str(tmp_path / "a"), checkpoint_every=10_000, task_kwargs=task_kwargs)
-    with pytest.raises(TrainingInterrupted):
-        a.run(stop_at_step=270)  # early in the second episode
+    a.run(until_step=270)  # early in the second episode
     assert a.loop.env.task.randomizer._pending  # actions in flight are part of the checkpoint
     path = str(tmp_path / "run.ckpt")
     a.save_checkpoint(path)
     b = DomainRun(plan, config, seed=2, run_dir=str(tmp_path / "b"), checkpoint_every=10_000, task_kwargs=task_kwargs)
     b.restore(path)
     assert_same_run(a, b)
-    with pytest.raises(TrainingInterrupted):
-        a.run(stop_at_step=310)
-    with pytest.raises(TrainingInterrupted):
-        b.run(stop_at_step=310)
+    a.run(until_step=310)
+    b.run(until_step=310)
     assert_same_run(a, b)
 
 
@@ -184,9 +180,8 @@ def test_robostrich_train_randomizes_and_its_policy_carries_what_it_observes(tmp
     args = ["--plan", "robostrich/lesson2:300", "--hidden-sizes", "32,32", "--batch-size", "32",
             "--min-replay-size", "100", "--updates-per-call", "4", "--env-steps-per-call", "8",
             "--checkpoint-every", "100", "--no-figures", "--no-rerun", "--quiet", "--no-baseline"]
-    with pytest.raises(TrainingInterrupted):
-        training.main(args + ["--randomize", "all=0.2,latency=0.5", "--out", str(tmp_path / "run"),
-                              "--stop-at-step", "120"])
+    with pytest.raises(Killed), killed_after(120):
+        training.main(args + ["--randomize", "all=0.2,latency=0.5", "--out", str(tmp_path / "run")])
     path = str(tmp_path / "run" / "curriculum" / "checkpoint.ckpt")
     fingerprint = checkpoint.read_fingerprint(path)
     assert fingerprint["task_kwargs"]["perturbation"] == {

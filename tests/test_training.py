@@ -1,4 +1,5 @@
 """Checkpoints, resumption and the curriculum, on dm_control's point_mass (real MuJoCo, tiny networks)."""
+import contextlib
 import dataclasses
 import json
 import os
@@ -8,8 +9,8 @@ import numpy as np
 import pytest
 
 from agents import checkpoint
-from agents.robostrich import main_job, training
-from agents.curriculum import LessonSettings, TrainingInterrupted, format_plan
+from agents.robostrich import main_job, training, training_progress
+from agents.curriculum import LessonSettings, format_plan
 from agents.robostrich.runs import DEFAULT_LESSONS, DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
@@ -39,11 +40,31 @@ def assert_same_run(a: DomainRun, b: DomainRun):
     np.testing.assert_array_equal(a.loop.env.physics.get_state(), b.loop.env.physics.get_state())
 
 
+class Killed(Exception):
+    """The process died: nothing is checkpointed on the way out."""
+
+
+@contextlib.contextmanager
+def killed_after(step: int):
+    """robostrich-train (one process) dies once a run has reached ``step`` control steps: the
+    progress bar, told after every chunk of steps, raises (chunks end at checkpoints and evaluations)."""
+    original = training_progress.Progress.update
+
+    def update(self, n, run):
+        original(self, n, run)
+        if run.loop.env_steps >= step:
+            raise Killed(f"at step {run.loop.env_steps}")
+    training_progress.Progress.update = update
+    try:
+        yield
+    finally:
+        training_progress.Progress.update = original
+
+
 def test_checkpoint_round_trips_bit_exactly_and_continues_identically(tmp_path):
     plan = parse_plan("point_mass/easy:700")
     a = DomainRun(plan, TINY, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
-    with pytest.raises(TrainingInterrupted):
-        a.run(stop_at_step=450)  # mid-episode, after learning started
+    a.run(until_step=450)  # mid-episode, after learning started
     assert a.loop.learner.num_updates > 0
     path = str(tmp_path / "run.ckpt")
     a.save_checkpoint(path)
@@ -60,8 +81,8 @@ def test_killed_and_resumed_run_matches_an_uninterrupted_one(tmp_path):
                         "--seed", "3", "--action-repeat", "2"]
     whole, killed = str(tmp_path / "whole"), str(tmp_path / "killed")
     training.main(args + ["--out", whole])
-    with pytest.raises(TrainingInterrupted):
-        training.main(args + ["--out", killed, "--stop-at-step", "1000"])  # last checkpoint at 800
+    with pytest.raises(Killed), killed_after(1000):  # last checkpoint at 800
+        training.main(args + ["--out", killed])
     with pytest.raises(ValueError, match="--resume"):
         training.main(args + ["--out", killed])  # never silently restarts over a checkpoint
     training.main(args + ["--out", killed, "--resume"])
@@ -281,13 +302,11 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
     other = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "long"), checkpoint_every=600, lessons=long)
     assert other.loop.learner.config.discount == 0.99
     for run in (plain, other):
-        with pytest.raises(TrainingInterrupted):
-            run.run(stop_at_step=400)
+        run.run(until_step=400)
     assert_same_run(plain, other)
     assert other.loop.learner.config.discount == 0.9 and plain.loop.learner.config.discount == 0.99
     plain.run()
-    with pytest.raises(TrainingInterrupted):
-        other.run(stop_at_step=600)
+    other.run(until_step=600)
     resumed = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "long"), lessons=long)
     resumed.restore()
     assert resumed.loop.learner.config.discount == 0.9
@@ -317,14 +336,12 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     actions = other.loop.learner.networks.action_size
     assert other.loop.learner.config.resolved_target_entropy(actions) == -2.0 * actions
     for run in (plain, other):
-        with pytest.raises(TrainingInterrupted):
-            run.run(stop_at_step=400)
+        run.run(until_step=400)
     assert_same_run(plain, other)
     at_switch = float(np.exp(other.loop.learner.state.log_alpha))
     assert other.loop.learner.config.resolved_target_entropy(actions) == 1.0 * actions
     plain.run()
-    with pytest.raises(TrainingInterrupted):
-        other.run(stop_at_step=600)
+    other.run(until_step=600)
     resumed = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "explore"), lessons=explore)
     resumed.restore()
     assert resumed.loop.learner.config.resolved_target_entropy(actions) == 1.0 * actions

@@ -125,7 +125,6 @@ def build_parser():
     _add_run_arguments(p.add_argument_group("what to train"))
     _add_file_arguments(p.add_argument_group("run directory and checkpoints"))
     _add_report_arguments(p.add_argument_group("evaluation and outputs"))
-    p.add_argument("--stop-at-step", type=positive_int, default=None, help=argparse.SUPPRESS)  # imitates a kill (tests)
     add_agent_arguments(p)
     return p
 
@@ -165,10 +164,14 @@ def main(argv=None):
 def start_runs(args, argv, setup: TrainingSetup, init: dict):
     """The runs' specs (and, trained here, the runs themselves, restored on --resume); a run that
     died before its first checkpoint loses its records; config.json. Returns (specs, runs)."""
-    specs = {label: RunSpec(label, tuple(run_plan), setup.config, args.seed, os.path.join(args.out, label),
-                            args.checkpoint_every, args.task_kwargs, args.layout, setup.lessons,
-                            setup.residual_scale, keep_lesson_checkpoints=args.keep_lesson_checkpoints,
-                            **(init if label == "curriculum" else {}))  # the baseline starts from scratch
+    transferred = {"curriculum": init} if init else {}  # the baseline starts from scratch
+    specs = {label: RunSpec(dict(plan=list(run_plan), config=setup.config, seed=args.seed,
+                                 run_dir=os.path.join(args.out, label), checkpoint_every=args.checkpoint_every,
+                                 name=label, task_kwargs=args.task_kwargs, layout=args.layout,
+                                 init_from=transferred.get(label, {}).get("init_digest"),
+                                 keep_lesson_checkpoints=args.keep_lesson_checkpoints, lessons=setup.lessons,
+                                 residual_scale=setup.residual_scale),
+                            transfer_from=transferred.get(label, {}).get("init_from"))
              for label, run_plan in setup.run_plans.items()}
     # Sequential: build (and restore) every run here; parallel: the workers do, once each.
     runs = {} if _parallel(args, specs) else {label: spec.build(restore=args.resume) for label, spec in specs.items()}
@@ -189,12 +192,8 @@ def start_runs(args, argv, setup: TrainingSetup, init: dict):
     return specs, runs
 
 
-def _workers(args) -> int:
-    return args.workers if args.stop_at_step is None else 1  # the kill hook raises in this process
-
-
 def _parallel(args, specs) -> bool:
-    return _workers(args) > 1 and len(specs) > 1
+    return args.workers > 1 and len(specs) > 1
 
 
 def train_all(args, setup: TrainingSetup, specs: dict, runs: dict):
@@ -205,7 +204,7 @@ def train_all(args, setup: TrainingSetup, specs: dict, runs: dict):
     job = RunJob(domain=setup.domain, heldout_task=setup.heldout_task, track_task=setup.track_task,
                  eval_at=tuple(eval_at), num_eval_targets=args.num_eval_targets,
                  final_eval_targets=args.final_eval_targets, out_eval=os.path.join(args.out, "evaluation"),
-                 record=not args.no_rerun, stop_at_step=args.stop_at_step)
+                 record=not args.no_rerun)
     episodes = evaluation.episode_count(setup.domain, final_targets(job), setup.track_task)
     progress = Progress(sum(spec.total_steps for spec in specs.values()), enabled=not args.quiet,
                         evaluations=episodes * (len(specs) + setup.domain.is_arm))  # the lookup's too
@@ -214,7 +213,7 @@ def train_all(args, setup: TrainingSetup, specs: dict, runs: dict):
     try:
         if _parallel(args, specs):  # the lookup's evaluation joins the workers' queue (a run's core once it is done)
             jobs = {**specs, LOOKUP_LABEL: LookupSpec()} if setup.domain.is_arm else specs
-            outcomes = train_in_parallel(jobs, job, progress, _workers(args))
+            outcomes = train_in_parallel(jobs, job, progress, args.workers)
             lookup = outcomes.pop(LOOKUP_LABEL)["reports"] if setup.domain.is_arm else None
         else:
             outcomes = {label: train_and_evaluate(run, job, progress) for label, run in runs.items()}

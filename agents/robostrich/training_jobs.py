@@ -1,6 +1,7 @@
 """What each of robostrich-train's runs is given and does: the run's description (picklable,
 for a worker), its periodic and final evaluations, and the lookup's evaluation as a job of its own."""
 import dataclasses
+import inspect
 import json
 import os
 import time
@@ -8,13 +9,12 @@ from typing import Optional
 
 import numpy as np
 
-from agents.curriculum import LessonSettings, read_records
+from agents.curriculum import read_records
 from agents.robostrich import evaluation, transfer
 from agents.robostrich.domains import Domain
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
-from agents.robostrich.runs import DEFAULT_LESSONS, DomainRun
+from agents.robostrich.runs import DomainRun
 from agents.sac.builder import SACBuilder
-from agents.sac.config import SACConfig
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import files
 
@@ -36,28 +36,33 @@ class RunJob:
     final_eval_targets: Optional[int]
     out_eval: str
     record: bool
-    stop_at_step: Optional[int] = None
 
 
 @dataclasses.dataclass(frozen=True)
 class RunSpec:
-    """Everything a DomainRun is built from (picklable): the parent process of a parallel
-    job passes it to a worker instead of building the run (networks, replay, environment)
-    itself, which it would only throw away."""
+    """A run not built yet (picklable): ``DomainRun``'s own keyword arguments, the one description
+    of a run, so that the parent of a parallel job passes it to a worker instead of building the
+    run (networks, replay, environment) itself, which it would only throw away. ``transfer_from``:
+    a checkpoint a fresh run's learner starts from (agents/robostrich/transfer.py; its content
+    hash is the run's ``init_from``)."""
 
-    label: str
-    plan: tuple
-    config: SACConfig
-    seed: int
-    run_dir: str
-    checkpoint_every: int
-    task_kwargs: Optional[dict]
-    layout: Optional[str]
-    lessons: LessonSettings = DEFAULT_LESSONS
-    residual_scale: float = 0.0
-    init_from: Optional[str] = None  # a checkpoint to start a fresh run's learner from (agents/robostrich/transfer.py)
-    init_digest: Optional[str] = None  # its content hash, kept in the run's fingerprint
-    keep_lesson_checkpoints: bool = False  # also a checkpoint after every lesson but the last
+    arguments: dict
+    transfer_from: Optional[str] = None
+
+    def __post_init__(self):
+        inspect.signature(DomainRun).bind(**self.arguments)  # a misnamed argument fails here, not in a worker
+
+    @property
+    def label(self) -> str:
+        return self.arguments["name"]
+
+    @property
+    def plan(self) -> list:
+        return self.arguments["plan"]
+
+    @property
+    def run_dir(self) -> str:
+        return self.arguments["run_dir"]
 
     @property
     def total_steps(self) -> int:
@@ -66,15 +71,11 @@ class RunSpec:
     def build(self, restore: bool) -> DomainRun:
         """The run; restored from its checkpoint when ``restore`` and one exists (raises on a
         damaged or mismatched checkpoint, never restarts silently)."""
-        run = DomainRun(list(self.plan), self.config, self.seed, self.run_dir,
-                        checkpoint_every=self.checkpoint_every, name=self.label,
-                        task_kwargs=self.task_kwargs, layout=self.layout, init_from=self.init_digest,
-                        keep_lesson_checkpoints=self.keep_lesson_checkpoints, lessons=self.lessons,
-                        residual_scale=self.residual_scale)
+        run = DomainRun(**self.arguments)
         if restore and os.path.exists(run.checkpoint_path):
             run.restore()
-        elif self.init_from is not None:
-            transfer.initialize(run, self.init_from, self.init_digest)
+        elif self.transfer_from is not None:
+            transfer.initialize(run, self.transfer_from, self.arguments.get("init_from"))
         return run
 
 
@@ -123,8 +124,7 @@ def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
         with files.naming(run.run_dir, only_unnamed=True), cli_lib.deferred_interrupts():
             # Ctrl-C: a checkpoint between chunks, then KeyboardInterrupt; a failed write of the
             # run's records (a full disk) names where the run writes
-            run.run(progress=progress, on_eval=on_eval, eval_at=job.eval_at, stop_at_step=job.stop_at_step,
-                    stop_requested=cli_lib.interrupted)
+            run.run(progress=progress, on_eval=on_eval, eval_at=job.eval_at, stop_requested=cli_lib.interrupted)
         timing = {"seconds": time.time() - start, "env_steps": run.loop.env_steps - start_steps,
                   "updates": run.loop.learner.num_updates}
     reports = evaluation.evaluate_agent(SACBuilder.make_eval_actor(run.loop), run.loop.flattener, job.out_eval,
