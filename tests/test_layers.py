@@ -94,3 +94,29 @@ def test_tools_find_the_packages_by_their_install():
     """tools/ scripts import the installed packages (pip install -e .): none edits sys.path by hand."""
     editing = [p.name for p in sorted((ROOT / "tools").glob("*.py")) if "sys.path" in p.read_text()]
     assert not editing, editing
+
+
+# The agent's imports of the project's own modules stand at the top of each module, where a reader
+# sees what it depends on; these stay inside functions because they pull in a library only some
+# commands need (rerun for recordings, gymnasium for the peer agents).
+LAZY_IMPORTS = {("agents/robostrich/recording.py", "robostrich_suite.rerun_log"),
+                ("agents/robostrich/recording.py", "robostrich_suite.rerun_blueprint"),
+                ("agents/robostrich/peers.py", "robostrich_suite.gym_adapter")}
+
+
+def test_the_agent_imports_the_projects_modules_at_the_top():
+    hidden = set()
+    for path in sorted((ROOT / "agents").rglob("*.py")):
+        where = path.relative_to(ROOT).as_posix()
+        functions = [n for n in ast.walk(ast.parse(path.read_text())) if isinstance(n, ast.FunctionDef)]
+        for node in (sub for function in functions for sub in ast.walk(function)):
+            if isinstance(node, ast.ImportFrom) and node.module:
+                targets = {node.module} | {f"{node.module}.{a.name}" for a in node.names}
+            elif isinstance(node, ast.Import):
+                targets = {a.name for a in node.names}
+            else:
+                continue
+            own = {t for t in targets if t.split(".")[0] in ("agents", "robostrich_suite")}
+            if own and not any((where, t) in LAZY_IMPORTS for t in own):
+                hidden.add(f"{where}:{node.lineno} imports {min(own)} inside a function")
+    assert not hidden, "\n".join(sorted(hidden))

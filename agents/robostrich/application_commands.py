@@ -14,11 +14,17 @@ import os
 
 import numpy as np
 
-from agents.robostrich import applications
+from agents.robostrich import application_figures, applications, gap, stabilization
+from agents.robostrich.evaluation import write_json
+from agents.robostrich.stabilization import GOALS
+from robostrich_suite import outputs, progress, web_viewer
+from robostrich_suite import cli as cli_lib
+from robostrich_suite.files import write_text
+from robostrich_suite.tasks import quadruped_tasks
+from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
 
 
 def _parser(description: str, out: str) -> argparse.ArgumentParser:
-    from robostrich_suite import cli as cli_lib
     parser = cli_lib.Parser(description=description)
     parser.add_argument("checkpoint", nargs="?", default=None,
                         help="checkpoint.ckpt of robostrich-train on robostrich_a1 (label 'trained'); "
@@ -36,14 +42,12 @@ def _parser(description: str, out: str) -> argparse.ArgumentParser:
     parser.add_argument("--no-rerun", action="store_true", help="no .rrd recordings")
     parser.add_argument("--no-figures", action="store_true", help="no PNG figure")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-    from robostrich_suite import web_viewer
     web_viewer.add_flags(parser)
     return parser
 
 
 def _setup(args):
     """Gait, policies and output directory, every input checked before any rollout."""
-    from robostrich_suite import outputs, web_viewer
     outputs.check_directory(args.out)
     web_viewer.check(args)
     gait = applications.load_gait(args.gait)
@@ -54,7 +58,6 @@ def _setup(args):
 
 def _progress(args, policies, task: str):
     """The bar over every rollout (robostrich_suite/progress.py: cleared if the command stops early)."""
-    from robostrich_suite import progress
     return progress.bar(not args.no_progress, total=len(policies) * args.seeds, desc=task, unit="rollout",
                         dynamic_ncols=True)
 
@@ -69,8 +72,6 @@ def _meta(args, task: str, policies) -> dict:
 
 
 def _write(out: str, name: str, report: dict, series: dict, table: str) -> list:
-    from agents.robostrich.evaluation import write_json
-    from robostrich_suite.files import write_text
     paths = [os.path.join(out, f"{name}_report.json"), os.path.join(out, f"{name}_series.json"),
              os.path.join(out, f"{name}_summary.txt")]
     write_json(paths[0], report)
@@ -92,7 +93,6 @@ def _report(args, name: str, meta: dict, results: dict, series: dict, table: str
     recordings = [] if args.no_rerun else [os.path.join(args.out, f"{name}_{p.label}.rrd") for p in policies]
     print(table + "wrote " + ", ".join(written + recordings), flush=True)
     if args.web:
-        from robostrich_suite import web_viewer
         web_viewer.serve(recordings, args.web_port)
     return {"meta": meta, "policies": results}
 
@@ -106,7 +106,6 @@ def _split_series(results: dict) -> tuple:
 
 # --- head_stabilize ---------------------------------------------------------------------------
 def stabilization_table(results: dict, meta: dict) -> str:
-    from agents.robostrich.stabilization import GOALS
     lines = [f"head_stabilize on {meta['domain']}{' (layout ' + meta['layout'] + ')' if meta['layout'] else ''}, "
              f"{meta['seeds']} gait phases, scored from {meta['settled_from_s']} s; mean [worst] over the phases",
              f"{'policy':<10} {'height RMS':>14} {'height max':>14} {'head/trunk vz':>15} {'P_d mean err':>15} "
@@ -130,8 +129,6 @@ def stabilization_table(results: dict, meta: dict) -> str:
 
 
 def stabilize_main(argv=None) -> dict:
-    from agents.robostrich import stabilization
-    from robostrich_suite import cli as cli_lib
     parser = _parser("Head stabilisation while walking (Sec. 5.2.1, Fig. 9): head height, vertical velocity, "
                      "distance P_d and attitude of each policy over 12 s of walking with two trunk-height changes.",
                      os.path.join("out", "stabilize"))
@@ -154,14 +151,12 @@ def stabilize_main(argv=None) -> dict:
     table = stabilization_table(results, meta)
 
     def plot(arrays, path):
-        from agents.robostrich import application_figures  # matplotlib only when a figure is drawn
         application_figures.stabilization_figure(arrays, path, args.settle)
     return _report(args, "stabilize", meta, results, series, table, policies, plot)
 
 
 def stabilize_cli(argv=None) -> int:
     """Console script `robostrich-stabilize` (exit 0, or 2 with one line)."""
-    from robostrich_suite import cli as cli_lib
     return cli_lib.run(stabilize_main, "robostrich-stabilize", argv)
 
 
@@ -183,10 +178,6 @@ def gap_table(results: dict, meta: dict) -> str:
 
 
 def gap_main(argv=None) -> dict:
-    from agents.robostrich import gap
-    from robostrich_suite import cli as cli_lib
-    from robostrich_suite.tasks import quadruped_tasks
-    from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
     parser = _parser("Reaching through a narrow gap (Sec. 5.2.2, Fig. 12): per sub-target reached, time to reach, "
                      "largest arm-wall contact force; success rate of reaching target 6 without the head touching.",
                      os.path.join("out", "gap"))
@@ -215,12 +206,10 @@ def gap_main(argv=None) -> dict:
     table = gap_table(results, meta)
 
     def plot(arrays, path):
-        from agents.robostrich import application_figures  # matplotlib only when a figure is drawn
         application_figures.gap_figure(arrays, gap.scene(), targets, tolerance, path)
     return _report(args, "gap", meta, results, series, table, policies, plot)
 
 
 def gap_cli(argv=None) -> int:
     """Console script `robostrich-gap` (exit 0, or 2 with one line)."""
-    from robostrich_suite import cli as cli_lib
     return cli_lib.run(gap_main, "robostrich-gap", argv)

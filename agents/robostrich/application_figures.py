@@ -14,6 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from robostrich_suite import files  # noqa: E402
+from agents.robostrich.gap import position_error
 
 COLORS = {"trained": "tab:blue", "reference": "tab:green", "zero": "tab:gray", "lookup": "tab:orange"}
 
@@ -129,7 +130,6 @@ def gap_figure(reports: dict, scene: dict, targets, position_tolerance: float,
                          fontsize=8)
     for i, (label, report) in enumerate(reports.items()):
         s, color = report["series"], _color(label, i)
-        from agents.robostrich.gap import position_error
         path_ax.plot(s["head_x"], s["head_z"], color=color, lw=1.0, label=label)
         error_ax.plot(s["time"], position_error(s), color=color, lw=1.0, label=label)
         attitude_ax.plot(s["time"], s["attitude"], color=color, lw=1.0, label=label)

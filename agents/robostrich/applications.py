@@ -20,9 +20,15 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from agents.replay import ObservationFlattener
 from agents.robostrich import probes
-from agents.robostrich.domains import Domain, as_domain
+from agents.robostrich.domains import as_domain, Domain
+from agents.robostrich.evaluation import load_run_from_checkpoint
+from agents.robostrich.lookup import LABEL, LookupPolicy
+from agents.robostrich.recording import open_recorder
+from agents.sac.builder import SACBuilder
 from robostrich_suite import cli as cli_lib
+from robostrich_suite.tasks import gait as gait_lib
 
 DOMAIN = "robostrich_a1"
 RECORD_EVERY = 5  # control steps per recorded frame (module doc)
@@ -41,7 +47,6 @@ class Policy:
 
     def bind(self, env):
         """(actor, flattener) for `env`."""
-        from agents.replay import ObservationFlattener
         spec = env.observation_spec()
         flattener = self.flattener or ObservationFlattener(spec)
         missing = [key for key in (flattener.keys or ()) if key not in spec]
@@ -69,15 +74,12 @@ def zero_policy(domain: Domain) -> Policy:
 def lookup_policy(domain: Domain) -> Policy:
     """Hold the stored input of the level pose nearest to the target (trunk frame), re-chosen
     every step as the target moves (agents/robostrich/lookup.py)."""
-    from agents.robostrich.lookup import LABEL, LookupPolicy
     table = domain.lookup_table()
     return Policy(LABEL, domain, lambda env, flattener: LookupPolicy(flattener, table))
 
 
 def checkpoint_policy(path: str, label: str) -> Policy:
     """The deterministic actor of a `robostrich-train` checkpoint trained on `robostrich_a1`."""
-    from agents.robostrich.evaluation import load_run_from_checkpoint
-    from agents.sac.builder import SACBuilder
     run = load_run_from_checkpoint(path)
     domain = run.domain()
     if domain.name != DOMAIN:
@@ -113,7 +115,6 @@ class PhaseShifted:
 
 def load_gait(path: Optional[str] = None):
     """The shipped gait file, or `path` (a gait CSV; a malformed one is a ValueError naming line and column)."""
-    from robostrich_suite.tasks import gait as gait_lib
     return gait_lib.GaitReplay.from_file(gait_lib.DATA_PATH if path is None else path)
 
 
@@ -157,7 +158,6 @@ def rollouts(policy: Policy, task: str, seeds: int, gait, record_for: Callable,
     """`policy` on `task` over `seeds` gait phases: yields (seed, environment, series) per phase.
     `record_for(env)` gives :func:`rollout`'s per-step `record`; the phase-0 rollout is recorded
     to `recording` (a .rrd path; None: no recording)."""
-    from agents.robostrich.recording import open_recorder
     for seed in range(seeds):
         env = make_environment(policy.domain, task, seed, seeds, gait, **task_kwargs)
         with open_recorder(recording if seed == 0 else None, f"{task} {policy.label}") as recorder:

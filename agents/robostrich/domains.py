@@ -20,6 +20,11 @@ import dataclasses
 from typing import Optional, Tuple
 
 import numpy as np
+import robostrich_suite
+from agents.robostrich.lookup import lookup_table, nearest
+from robostrich_suite import targets
+from robostrich_suite.model import layouts
+from robostrich_suite.tasks import options, quadruped_tasks, reach
 
 # Tasks on an arm domain whose episodes start from the fixed pose (held-out
 # evaluation) and continue from the last state (moving starts).
@@ -29,7 +34,6 @@ TRACK_TASK = "track"
 
 
 def arm_domains() -> Tuple[str, ...]:
-    import robostrich_suite
     return tuple(robostrich_suite.TASKS_BY_DOMAIN)
 
 
@@ -43,19 +47,16 @@ class Domain:
 
     def __post_init__(self):
         if self.layout is None and self.is_arm:  # the tasks' own routing, by name
-            from robostrich_suite.model import layouts
             object.__setattr__(self, "layout", layouts.DEFAULT)
         if self.layout is not None:
             if not self.is_arm:
                 raise ValueError(f"--layout applies to the arm domains {list(arm_domains())}, "
                                  f"not to {self.name!r}")
-            from robostrich_suite.model import layouts
             layouts.target_file(self.layout)  # names the built-in layouts, or those that ship targets
         if self.sent_actions:
             if not self.is_arm:
                 raise ValueError(f"observe_sent_actions applies to the arm domains {list(arm_domains())}, "
                                  f"not to {self.name!r}")
-            from robostrich_suite.tasks import options, reach
             object.__setattr__(self, "sent_actions", options.whole(
                 "observe_sent_actions", self.sent_actions, 0, reach.MAX_SENT_ACTIONS, "a whole number of control steps"))
 
@@ -67,7 +68,6 @@ class Domain:
 
     def tasks(self) -> Tuple[str, ...]:
         if self.is_arm:
-            import robostrich_suite
             return tuple(robostrich_suite.TASKS_BY_DOMAIN[self.name])
         from dm_control import suite
         return tuple(task for domain, task in suite.ALL_TASKS if domain == self.name)
@@ -78,7 +78,6 @@ class Domain:
         if not self.is_arm:
             raise ValueError(f"{self.name!r} is not a robostrich_suite domain and has no curriculum: "
                              "give its tasks with --lessons or --plan")
-        import robostrich_suite
         return tuple(task for domain, task in robostrich_suite.CURRICULUM_TASKS if domain == self.name)
 
     def check_task(self, task: str) -> None:
@@ -97,14 +96,12 @@ class Domain:
 
     # -- environments ------------------------------------------------------------------------
     def _target_file(self):
-        from robostrich_suite.model import layouts
         return layouts.target_file(self.layout)
 
     def _to_domain_frame(self, frame_targets) -> np.ndarray:
         """Targets of the frame arm in this domain's coordinates (the trunk frame on the quadruped)."""
         frame_targets = np.asarray(frame_targets, np.float64)
         if self.on_quadruped:
-            from robostrich_suite.tasks import quadruped_tasks
             return quadruped_tasks.frame_to_trunk(frame_targets)
         return frame_targets
 
@@ -112,9 +109,6 @@ class Domain:
         """The task kwargs a layout implies: the layout, and its own training (or `track`) targets."""
         if self.layout is None:
             return {}
-        from robostrich_suite.model import layouts
-        from robostrich_suite.tasks import reach
-        from robostrich_suite import targets
         kwargs = {"tendon_layout": layouts.build(self.layout)}
         if task == TRACK_TASK:
             kwargs["targets"] = reach.default_track_targets(self.heldout_targets())
@@ -131,7 +125,6 @@ class Domain:
                 and task_kwargs.get("start_inputs") is None):
             task_kwargs["start_inputs"] = self.stored_start_inputs()
         if self.is_arm:
-            import robostrich_suite
             return robostrich_suite.load(self.name, task, task_kwargs=task_kwargs)
         from dm_control import suite
         return suite.load(self.name, task, task_kwargs=task_kwargs)
@@ -153,7 +146,6 @@ class Domain:
         """The layout's held-out targets in this domain's frame; None (seeded episodes) off the arm."""
         if not self.is_arm:
             return None
-        from robostrich_suite import targets
         pool = self._to_domain_frame(targets.heldout_targets(self._target_file()))
         return pool if num_targets is None else pool[spread_indices(len(pool), num_targets)]
 
@@ -162,8 +154,6 @@ class Domain:
         domain's frame; None off the arm."""
         if not self.is_arm:
             return None
-        from agents.robostrich.lookup import lookup_table
-        from robostrich_suite import targets
         path = self._target_file()
         table = lookup_table(targets.level_head_poses(path), targets.heldout_targets(path))
         table["head_position"] = self._to_domain_frame(table["head_position"])
@@ -172,9 +162,6 @@ class Domain:
     def moving_starts(self, count: int = 3):
         """Start poses of `heldout_moving`: `count` well separated training targets (picked as `track`
         picks its targets) and the stored inputs that hold them (never a held-out pose)."""
-        from agents.robostrich.lookup import nearest
-        from robostrich_suite.tasks import reach
-        from robostrich_suite import targets
         table = self.lookup_table()
         starts = reach.default_track_targets(
             self._to_domain_frame(targets.training_targets(self._target_file())), count)
@@ -184,7 +171,6 @@ class Domain:
         """Tendon inputs for lesson 3's ``stored_starts``: the lookup table's (so no held-out
         pose), minus every pose within `exclusion` (m) of the evaluation's moving starts, so the
         moving-start evaluation still starts where training never started."""
-        from agents.robostrich.lookup import lookup_table
         starts, _ = self.moving_starts()
         return lookup_table(self.lookup_table(), heldout=starts, exclusion=exclusion)["control"]
 

@@ -18,10 +18,18 @@ from typing import Optional
 
 import numpy as np
 
+from agents import checkpoint
+from agents.curriculum import LessonSettings
+from agents.replay import ObservationFlattener
+from agents.robostrich import figures, probes
+from agents.robostrich.domains import as_domain, domain_of, MOVING_START_TASK, TRACK_TASK
+from agents.robostrich.lookup import LABEL, LookupPolicy
+from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
+from agents.robostrich.recording import open_recorder
+from agents.robostrich.runs import DomainRun, make_environment, parse_plan
+from agents.sac.builder import SACBuilder
+from agents.sac.config import SACConfig
 from robostrich_suite import files, outputs, parsing, web_viewer
-from agents.robostrich import probes
-from agents.robostrich.runs import make_environment
-from agents.robostrich.domains import MOVING_START_TASK, TRACK_TASK, as_domain
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import progress as progress_lib
 from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, PRECISE_POSITION_TOLERANCE
@@ -34,7 +42,6 @@ MAX_LABEL_BYTES = 100  # a label starts file names (LABEL_heldout_moving.json): 
 def evaluation_label(text: str) -> str:
     """argparse type of --label: a name that starts the report files' names, not a path (a label
     with a separator or '..' would write outside --out), nor the lookup baseline's own."""
-    from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
     if not text or text in (".", "..") or any(c in text for c in ("/", "\\", "\0")):
         raise argparse.ArgumentTypeError(f"must be a name for the report files (no '/', not '..'), got {text!r}")
     if len(os.fsencode(text)) > MAX_LABEL_BYTES:
@@ -257,7 +264,6 @@ def evaluate_agent(actor, flattener, out_dir: str, label: str, domain, heldout_t
         reports["heldout_moving"] = evaluate_heldout_moving(actor, flattener, domain, num_targets,
                                                             action_repeat=action_repeat, on_episode=on_episode)
     if track_task:
-        from agents.robostrich.recording import open_recorder
         with open_recorder(os.path.join(out_dir, f"{label}_track.rrd") if record else None,
                            f"{label} track") as recorder:
             reports["track"] = evaluate_track(actor, flattener, domain, track_task, recorder=recorder,
@@ -319,8 +325,6 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
     domain = as_domain(domain)
     if not domain.is_arm:
         return None
-    from agents.robostrich.lookup import LABEL, LookupPolicy
-    from agents.replay import ObservationFlattener
     flattener = ObservationFlattener(make_environment(domain, heldout_task, 0).observation_spec())
     return evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain,
                           heldout_task, track_task, num_targets, env_steps=0, record=record, action_repeat=1,
@@ -343,8 +347,6 @@ def _json_default(o):
 def checked_fingerprint(path: str) -> dict:
     """The fingerprint of a robostrich-train checkpoint, after checking that it holds
     what a run is rebuilt from: a CheckpointError naming what it lacks, before anything is built."""
-    from agents import checkpoint
-    from agents.robostrich.runs import DomainRun
     record, _ = checkpoint.read_with_digest(path)
     fp = record["fingerprint"]
     missing = ([k for k in ("plan", "config", "lessons", "seed") if k not in fp]
@@ -356,17 +358,12 @@ def checked_fingerprint(path: str) -> dict:
 
 def checkpoint_domain(fingerprint: dict):
     """The domain (and layout) a checkpoint's run trained its last lesson on."""
-    from agents.robostrich.runs import parse_plan
-    from agents.robostrich.domains import domain_of
     return domain_of({"domain": parse_plan(fingerprint["plan"])[-1].domain, "layout": fingerprint.get("layout")},
                      fingerprint.get("task_kwargs"))
 
 
 def load_run_from_checkpoint(path: str):
     """Rebuild the DomainRun that wrote `path` (its fingerprint holds config, plan and seed)."""
-    from agents.curriculum import LessonSettings
-    from agents.robostrich.runs import DomainRun, parse_plan
-    from agents.sac.config import SACConfig
     fp = checked_fingerprint(path)
     scratch = tempfile.mkdtemp(prefix="robostrich-evaluate-")  # the run's own files are left untouched
     try:
@@ -405,11 +402,9 @@ def main(argv=None):
     track_task = check_track_task(domain, args.track_task)
     if args.web and not track_task:
         raise ValueError("--web serves the track task's recordings, and this evaluation runs no track task")
-    from agents.robostrich.runs import parse_plan
     heldout_task = check_heldout_task(domain, args.heldout_task
                                       or default_heldout_task(domain, parse_plan(fingerprint["plan"])[-1].task))
     run = load_run_from_checkpoint(args.checkpoint)
-    from agents.sac.builder import SACBuilder
     actor = SACBuilder.make_eval_actor(run.loop)
     labels = 2 if domain.is_arm else 1  # the lookup beside the agent on the arm
     with progress_lib.bar(not args.quiet, total=labels * episode_count(domain, args.num_targets, track_task),
@@ -424,7 +419,6 @@ def main(argv=None):
     if lookup is not None:
         reports["lookup"] = lookup
     if not args.no_figures and "track" in reports[args.label]:
-        from agents.robostrich import figures
         figures.plot_track({label: r["track"] for label, r in reports.items()},
                            os.path.join(out, f"{args.label}_track.png"))
     summary = {label: {kind: r["summary"] for kind, r in rs.items()} for label, rs in reports.items()}

@@ -22,6 +22,8 @@ import mujoco
 import numpy as np
 
 from agents.robostrich import applications
+from robostrich_suite import scenes
+from robostrich_suite.physics import arm_ids, arm_indices
 
 TASK = "narrow_gap"
 OBSTACLE_PREFIX = "gap_"
@@ -32,7 +34,6 @@ class ContactProbe:
     contact forces between them at the current state."""
 
     def __init__(self, physics):
-        from robostrich_suite.physics import arm_ids, arm_indices
         model = physics.model
         self.obstacle = {g for g in range(model.ngeom)
                          if (model.id2name(g, "geom") or "").startswith(OBSTACLE_PREFIX)}
@@ -188,12 +189,13 @@ def evaluate(policies: list, seeds: int, gait, record_dir: Optional[str] = None,
 
 def scene() -> dict:
     """The obstacle's outline in the x-z plane (for the figure): wall, shelf pieces, slot."""
-    from robostrich_suite import scenes as s
-    x0, shelf_top = s.GAP_WALL_X, s.GAP_SHELF_BOTTOM + s.GAP_SHELF_THICKNESS
+    x0, bottom = scenes.GAP_WALL_X, scenes.GAP_SHELF_BOTTOM
+    shelf_top = bottom + scenes.GAP_SHELF_THICKNESS
+    slot_near = x0 + scenes.GAP_SLOT_X - scenes.GAP_SLOT_WIDTH / 2
+    slot_far = x0 + scenes.GAP_SLOT_X + scenes.GAP_SLOT_WIDTH / 2
     return {
-        "wall": [x0 - s.WALL_THICKNESS, shelf_top, x0, s.GAP_WALL_TOP],  # x0, z0, x1, z1
-        "shelf_near": [x0 - s.WALL_THICKNESS, s.GAP_SHELF_BOTTOM, x0 + s.GAP_SLOT_X - s.GAP_SLOT_WIDTH / 2, shelf_top],
-        "shelf_far": [x0 + s.GAP_SLOT_X + s.GAP_SLOT_WIDTH / 2, s.GAP_SHELF_BOTTOM, x0 + s.GAP_SHELF_DEPTH, shelf_top],
-        "slot": [x0 + s.GAP_SLOT_X - s.GAP_SLOT_WIDTH / 2, s.GAP_SHELF_BOTTOM, x0 + s.GAP_SLOT_X + s.GAP_SLOT_WIDTH / 2,
-                 shelf_top],
+        "wall": [x0 - scenes.WALL_THICKNESS, shelf_top, x0, scenes.GAP_WALL_TOP],  # x0, z0, x1, z1
+        "shelf_near": [x0 - scenes.WALL_THICKNESS, bottom, slot_near, shelf_top],
+        "shelf_far": [slot_far, bottom, x0 + scenes.GAP_SHELF_DEPTH, shelf_top],
+        "slot": [slot_near, bottom, slot_far, shelf_top],
     }

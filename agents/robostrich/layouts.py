@@ -9,8 +9,15 @@ import pathlib
 import numpy as np
 
 import robostrich_suite
-from robostrich_suite import cli as cli_lib
+from agents.replay import ObservationFlattener
+from agents.robostrich import evaluation
+from agents.robostrich.lookup import lookup_table, LookupPolicy
+from agents.robostrich.main_job import FIXED_START_ARM_TASK_KWARGS
+from agents.robostrich.runs import DomainRun, make_environment, parse_plan
+from agents.sac.builder import SACBuilder
+from agents.sac.config import SACConfig
 from robostrich_suite import targets
+from robostrich_suite import cli as cli_lib
 from robostrich_suite.studies import layout_compare
 
 DEFAULT_TRAIN_STEPS = 4000
@@ -19,8 +26,6 @@ DEFAULT_TRAIN_STEPS = 4000
 def heldout_success(case: layout_compare.Case, heldout: np.ndarray, make_actor, seed: int = 10_000) -> dict:
     """``evaluation``'s held-out summary on the case's arm: one lesson-2 episode from the fixed
     start per target.  ``make_actor(flattener)`` gives the policy."""
-    from agents.replay import ObservationFlattener
-    from agents.robostrich import evaluation
     env = robostrich_suite.load("robostrich", evaluation.default_heldout_task("robostrich", "lesson3"),
                                 task_kwargs=dict(random=seed, arm_spec=case.spec,
                                                  tendon_layout=case.layout, target_pool=heldout[:1]))
@@ -35,7 +40,6 @@ def heldout_success(case: layout_compare.Case, heldout: np.ndarray, make_actor, 
 
 def lookup_success(case, target_path: pathlib.Path, options) -> dict:
     """The lookup baseline on the case's own targets (its table keeps no held-out pose)."""
-    from agents.robostrich.lookup import LookupPolicy, lookup_table
     heldout = targets.heldout_targets(target_path) if _has_targets(target_path) else []
     if not len(heldout):
         return {"lookup_success": None}
@@ -46,10 +50,6 @@ def lookup_success(case, target_path: pathlib.Path, options) -> dict:
 def curriculum_success(case, target_path: pathlib.Path, options, steps: int = DEFAULT_TRAIN_STEPS) -> dict:
     """A short curriculum (lessons 1-3 in equal parts, ``robostrich-train``'s learner and
     defaults) on the case's own training targets, then its held-out success."""
-    from agents.robostrich.runs import DomainRun, make_environment, parse_plan
-    from agents.robostrich.main_job import FIXED_START_ARM_TASK_KWARGS
-    from agents.sac.builder import SACBuilder
-    from agents.sac.config import SACConfig
     if not _has_targets(target_path) or not len(targets.heldout_targets(target_path)) \
             or not len(targets.training_targets(target_path)):
         return {"curriculum_success": None}

@@ -14,6 +14,7 @@ from typing import Optional
 
 import numpy as np
 
+from agents.replay import ObservationFlattener
 from agents.robostrich import evaluation
 from agents.robostrich.domains import Domain
 
@@ -103,7 +104,6 @@ def segments(plan, eval_at) -> list:
 def train(spec: PeerSpec) -> dict:
     """Train the peer through its plan (a held-out evaluation at every point of ``eval_at``, into
     OUT/evals.jsonl), then the final evaluation (OUT/evaluation/LABEL_*.json); returns its result."""
-    from agents.replay import ObservationFlattener
     domain = Domain(spec.plan[-1].domain, spec.layout)
     env = make_env(domain, spec.plan[0].task, spec.seed, spec.task_kwargs)
     model = build_model(spec.agent, env, spec.seed)

@@ -9,11 +9,11 @@ the recording in the browser until Ctrl-C (robostrich_suite/web_viewer.py).
 """
 import os
 
-from agents.robostrich import evaluation, figures
-from agents.robostrich.domains import TRACK_TASK, as_domain, domain_of
+from agents.robostrich import application_figures, applications, evaluation, figures, stabilization
+from agents.robostrich.domains import as_domain, domain_of, TRACK_TASK
 from agents.robostrich.recording import open_recorder
-from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs, policies, web_viewer
+from robostrich_suite import cli as cli_lib
 
 LABEL = "policy"
 
@@ -43,7 +43,6 @@ def play_track(policy, domain, args) -> tuple:
 
 def play_stabilize(policy, domain, args) -> tuple:
     """`head_stabilize` (Fig. 9) over one gait phase: (its metrics, the files written in args.out)."""
-    from agents.robostrich import application_figures, applications, stabilization
     compared = applications.Policy(LABEL, domain, lambda env, flattener: policy)
     results = stabilization.evaluate([compared], 1, applications.load_gait(),
                                      record_dir=None if args.no_rerun else args.out)

@@ -8,6 +8,7 @@ import numpy as np
 
 from agents import checkpoint
 from agents.actors import ResidualAdapter
+from agents.robostrich.evaluation import default_heldout_task, load_run_from_checkpoint
 from agents.robostrich.runs import make_environment
 from robostrich_suite import policies
 from robostrich_suite import fingerprint as fingerprint_lib
@@ -24,7 +25,6 @@ def _layers(params: dict):
 
 def export_policy(checkpoint_path: str, out_path: str, command: str = "") -> policies.Policy:
     """Write the policy of the run that wrote ``checkpoint_path`` to ``out_path`` and return it."""
-    from agents.robostrich.evaluation import default_heldout_task, load_run_from_checkpoint
     run = load_run_from_checkpoint(checkpoint_path)
     if isinstance(run.loop.actor.adapter, ResidualAdapter):
         raise ValueError(f"{checkpoint_path}: a residual policy needs its base controller; only plain policies export")

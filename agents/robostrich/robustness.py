@@ -14,11 +14,13 @@ import argparse
 import os
 
 
-from agents.robostrich import evaluation
-from agents.robostrich.domains import Domain, as_domain, domain_of
+from agents.replay import ObservationFlattener
+from agents.robostrich import evaluation, robustness_figure
+from agents.robostrich.domains import as_domain, Domain, domain_of
+from agents.robostrich.lookup import LABEL, LookupPolicy
+from agents.sac.builder import SACBuilder
+from robostrich_suite import outputs, policies
 from robostrich_suite import cli as cli_lib
-from robostrich_suite import outputs
-from robostrich_suite import policies
 from robostrich_suite.tasks import perturbations
 
 DEFAULT_SCALES = (0.0, 0.1, 0.2, 0.3, 0.5)
@@ -87,7 +89,6 @@ def load_evaluated(spec: str, label: str) -> Evaluated:
         fingerprint = evaluation.checked_fingerprint(spec)
         domain = evaluation.checkpoint_domain(fingerprint)
         run = evaluation.load_run_from_checkpoint(spec)
-        from agents.sac.builder import SACBuilder
         return Evaluated(label, SACBuilder.make_eval_actor(run.loop), run.loop.flattener, domain,
                          run.config.action_repeat, spec)
     policy = policies.load_policy(spec)
@@ -99,8 +100,6 @@ def load_evaluated(spec: str, label: str) -> Evaluated:
 
 
 def lookup_evaluated(domain) -> Evaluated:
-    from agents.replay import ObservationFlattener
-    from agents.robostrich.lookup import LABEL, LookupPolicy
     domain = as_domain(domain)
     env = evaluation.make_environment(domain, evaluation.default_heldout_task(domain, "track"), 0)
     flattener = ObservationFlattener(env.observation_spec())
@@ -211,7 +210,6 @@ def main(argv=None) -> dict:
     results = measure(evaluated, domain, args.scales, args.num_targets, progress=not args.no_progress)
     report = summary(args, evaluated, results, domain)
     evaluation.write_json(os.path.join(args.out, "robustness.json"), report)
-    from agents.robostrich import robustness_figure
     robustness_figure.plot(report, os.path.join(args.out, "robustness.png"))
     for family, levels in report["falls_below"].items():
         line = ", ".join(f"below {float(k) * 100:.0f} % at s = {v}" for k, v in levels.items() if v is not None)

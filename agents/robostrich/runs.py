@@ -6,8 +6,10 @@ from typing import Callable, Optional, Sequence
 from agents import curriculum
 from agents.curriculum import Lesson, LessonSettings
 from agents.robostrich import environment_state, probes
-from agents.robostrich.domains import as_domain
+from agents.robostrich.domains import as_domain, Domain
+from agents.robostrich.lookup import LookupPolicy
 from agents.sac.config import SACConfig
+from robostrich_suite import files
 
 DEFAULT_DOMAIN = "robostrich"
 # What changes with the lesson unless a run says otherwise (robostrich-train's defaults too): hindsight
@@ -107,7 +109,6 @@ class DomainRun(curriculum.CurriculumRun):
 
     def save_checkpoint(self, path: Optional[str] = None):
         """CurriculumRun's, with a failed write (a full disk) naming the checkpoint."""
-        from robostrich_suite import files
         path = path or self.checkpoint_path
         with files.naming(path, only_unnamed=True):
             super().save_checkpoint(path)
@@ -123,11 +124,9 @@ class DomainRun(curriculum.CurriculumRun):
         """(base policy factory, scale) of a residual on the first lesson's lookup, or None."""
         if self.residual_scale <= 0:
             return None
-        from agents.robostrich.lookup import LookupPolicy
         table = self.domain(plan[0]).lookup_table()
         return (lambda flattener: LookupPolicy(flattener, table)), self.residual_scale
 
     def domain(self, lesson: Optional[Lesson] = None):
         """The Domain of `lesson` (default: the last), with this run's layout."""
-        from agents.robostrich.domains import Domain
         return Domain((lesson or self.plan[-1]).domain, self.layout, self.task_kwargs.get("observe_sent_actions", 0))

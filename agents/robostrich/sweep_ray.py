@@ -18,6 +18,8 @@ import sys
 import tempfile
 import threading
 import time
+from agents.robostrich.sweep_table import TIMING_FILE
+from robostrich_suite.files import write_text
 
 INSTALL_HINT = "Ray is not installed; pip install -e '.[sweep]' (or pip install ray==2.60.0)"
 # A Unix socket path holds at most 107 bytes; Ray puts its sockets below its temporary directory
@@ -186,8 +188,6 @@ def last_error(log_path: str) -> str:
 def _write_timing(run_dir: str, minutes: float, argv: list) -> None:
     """The wall-clock of the command that finished the run, beside its summary (sweep_table.run_minutes)."""
     import json
-    from agents.robostrich.sweep_table import TIMING_FILE
-    from robostrich_suite.files import write_text
     write_text(os.path.join(run_dir, TIMING_FILE),
                json.dumps({"minutes": minutes, "resumed": "--resume" in argv, "argv": argv}, indent=1))
 

@@ -28,7 +28,9 @@ from typing import Dict, Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from agents import checkpoint, trees
+from agents.robostrich.runs import named_layout, parse_plan
 from agents.sac.config import SACConfig
+from robostrich_suite.tasks import quadruped_tasks as qt
 
 # Config fields that make two networks different functions of their inputs.
 NETWORK_FIELDS = ("hidden_sizes", "critic_layer_norm", "log_std_min", "log_std_max")
@@ -43,7 +45,6 @@ def correspondence(source_domain: str, target_domain: str) -> Tuple[Mapping, Map
     if source_domain == target_domain:
         return {}, {}
     if (source_domain, target_domain) == ("robostrich", "robostrich_a1"):
-        from robostrich_suite.tasks import quadruped_tasks as qt
         return qt.FRAME_OBSERVATION_SOURCES, {k: qt.FRAME_TO_TRUNK_OFFSET for k in qt.FRAME_POSITION_KEYS}
     raise TransferError(f"--init-from: a checkpoint of {source_domain!r} cannot start a run on {target_domain!r} "
                         "(supported: the same domain, or robostrich -> robostrich_a1)")
@@ -219,7 +220,6 @@ def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = Non
                  residual_scale: float = 0.0) -> InitSource:
     """Everything that can be checked before building the run: a readable checkpoint, of a domain that can
     start `plan`'s, with the same tendon layout and networks.  TransferError (FileNotFoundError) otherwise."""
-    from agents.robostrich.runs import named_layout, parse_plan
     if record is None:
         record, digest = _read(path)
     else:
