@@ -7,7 +7,11 @@ import subprocess
 import numpy as np
 import pytest
 
-from agents.robostrich import application_commands, application_figures, applications, gap, stabilization
+from agents.robostrich.applications import commands as application_commands
+from agents.robostrich.applications import figures as application_figures
+from agents.robostrich.applications import rollouts as applications
+from agents.robostrich.applications import narrow_gap as gap
+from agents.robostrich.applications import stabilization
 from robostrich_suite.tasks import quadruped_tasks
 
 from conftest import console_script
@@ -79,7 +83,7 @@ def test_narrow_gap_reports_every_sub_target_with_contact_forces_from_a_real_rol
 
 
 def test_a_checkpoint_is_evaluated_beside_the_references(tmp_path):
-    from agents.robostrich.runs import DomainRun, parse_plan
+    from agents.robostrich.domain_run import DomainRun, parse_plan
     from agents.sac.config import SACConfig
     config = SACConfig(batch_size=16, hidden_sizes=(16, 16), min_replay_size=50, max_replay_size=1000)
     run = DomainRun(parse_plan("robostrich_a1/lesson1:100"), config, seed=0, run_dir=str(tmp_path / "run"))

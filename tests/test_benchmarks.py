@@ -85,7 +85,7 @@ def test_benchmark_seeds_is_the_sweep_with_its_own_default_directory(monkeypatch
     """tools/benchmark_seeds.py hands its arguments to robostrich-sweep (tests/test_sweep.py runs it
     for real), keeping its old default directory."""
     tool = load_tool("benchmark_seeds")
-    from agents.robostrich import sweep
+    from agents.robostrich.sweep import command as sweep
     calls = []
     monkeypatch.setattr(sweep, "cli", lambda argv: calls.append(argv) or 0)
     assert tool.main(["--seeds", "0,1", "--steps", "600"]) == 0

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from agents import checkpoint
-from agents.robostrich.runs import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun, parse_plan
 from agents.robostrich.domains import Domain
 from agents.sac.config import SACConfig
 from robostrich_suite import targets
@@ -123,7 +123,8 @@ def test_default_lessons_are_the_domains_curriculum():
     """Without --lessons/--plan, robostrich-train runs Algorithm 1 of the chosen domain: lessons 1-3
     on the frame, 1-4 (lesson 4 trotting) on the quadruped; a dm_control domain must name its tasks."""
     from agents.curriculum import LessonSettings
-    from agents.robostrich import main_job, training
+    from agents.robostrich.train import main_job
+    from agents.robostrich.train import command as training
     parse = training.build_parser().parse_args
     frame = main_job.plan_from_args(parse(["--steps", "300"]))
     assert [(l.domain, l.task, l.steps) for l in frame] == [
@@ -142,7 +143,8 @@ def test_quadruped_main_job_runs_all_four_lessons_and_resumes_mid_lesson4_exactl
     at a tiny budget: killed while the quadruped trots (its trunk height schedule under way), a run
     restored from its checkpoint continues exactly as the run that was never stopped."""
     from agents.curriculum import LessonSettings
-    from agents.robostrich import main_job, training
+    from agents.robostrich.train import main_job
+    from agents.robostrich.train import command as training
     args = training.build_parser().parse_args(["--domain", "robostrich_a1", "--steps", "300"])
     plan = main_job.plan_from_args(args)
     assert [(l.task, l.steps) for l in plan] == [("lesson1", 64), ("lesson2", 64), ("lesson3", 112), ("lesson4", 60)]

@@ -10,9 +10,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from agents.robostrich import evaluation, figures
+from agents.robostrich import figures
+from agents.robostrich.evaluate import evaluation
 from agents.replay import ObservationFlattener
-from agents.robostrich.runs import make_environment
+from agents.robostrich.domain_run import make_environment
 from robostrich_suite.studies import movement, movement_figure, walk, walk_figure
 from robostrich_suite.tasks import quadruped_tasks
 

@@ -7,7 +7,7 @@ import pytest
 
 from agents.curriculum import LessonSettings
 from agents.replay import ReplayBuffer
-from agents.robostrich.runs import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
 HER = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=100, max_replay_size=5000,

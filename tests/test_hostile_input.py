@@ -219,7 +219,7 @@ def test_torn_and_damaged_metrics_lines(tmp_path):
 
 def test_a_torn_evaluation_report_is_named(tmp_path):
     """A worker's report that a crash left in part is a ValueError naming the file, not a bare JSON error."""
-    from agents.robostrich.evaluation import read_reports
+    from agents.robostrich.evaluate.evaluation import read_reports
     (tmp_path / "curriculum_heldout.json").write_text('{"summary": {"success_rate": 1.0}}')
     (tmp_path / "curriculum_track.json").write_text('{"summary": {"succ')
     with pytest.raises(ValueError, match=r"curriculum_track\.json"):

@@ -101,7 +101,7 @@ def test_tools_find_the_packages_by_their_install():
 # commands need (rerun for recordings, gymnasium for the peer agents).
 LAZY_IMPORTS = {("agents/robostrich/recording.py", "robostrich_suite.rerun_log"),
                 ("agents/robostrich/recording.py", "robostrich_suite.rerun_blueprint"),
-                ("agents/robostrich/peers.py", "robostrich_suite.gym_adapter")}
+                ("agents/robostrich/peers/sbx_agents.py", "robostrich_suite.gym_adapter")}
 
 
 def test_the_agent_imports_the_projects_modules_at_the_top():

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from dm_env import specs
 
-from agents.robostrich import evaluation
-from agents.robostrich.runs import DomainRun, make_environment, parse_plan
+from agents.robostrich.evaluate import evaluation
+from agents.robostrich.domain_run import DomainRun, make_environment, parse_plan
 from agents.robostrich.lookup import LookupPolicy, lookup_table
 from agents.replay import ObservationFlattener
 from agents.sac.builder import SACBuilder

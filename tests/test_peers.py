@@ -13,8 +13,9 @@ import pytest
 pytest.importorskip("sbx")
 
 from agents.curriculum import Lesson  # noqa: E402
-from agents.robostrich import peers, peers_benchmark as bench  # noqa: E402
-from agents.robostrich import main_job  # noqa: E402
+from agents.robostrich.peers import sbx_agents as peers
+from agents.robostrich.peers import benchmark as bench  # noqa: E402
+from agents.robostrich.train import main_job  # noqa: E402
 from agents.robostrich.domains import Domain  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]

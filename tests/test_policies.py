@@ -10,9 +10,9 @@ import pytest
 from conftest import console_script
 
 import robostrich_suite
-from agents.robostrich.runs import DomainRun, parse_plan
-from agents.robostrich.evaluation import evaluate_track
-from agents.robostrich.policy_export import export_policy
+from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.evaluate.evaluation import evaluate_track
+from agents.robostrich.evaluate.policy_export import export_policy
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from robostrich_suite import policies

@@ -10,8 +10,8 @@ import pytest
 import robostrich_suite
 from robostrich_suite import policies
 from agents import checkpoint
-from agents.robostrich import training
-from agents.robostrich.runs import DomainRun, parse_plan
+from agents.robostrich.train import command as training
+from agents.robostrich.domain_run import DomainRun, parse_plan
 from robostrich_suite.tasks import perturbations
 from robostrich_suite.tasks.perturbations import Perturbation
 from conftest import console_script, finish, start
@@ -175,8 +175,9 @@ def test_robostrich_train_randomizes_and_its_policy_carries_what_it_observes(tmp
     every lesson's task and the checkpoint's fingerprint (and so through robostrich-sweep, which
     passes training flags on); evaluation, the policy file and the robustness tool rebuild the
     observation from it; bad scales and families are refused first."""
-    from agents.robostrich import evaluation, robustness
-    from agents.robostrich.policy_export import export_policy
+    from agents.robostrich.evaluate import evaluation
+    from agents.robostrich.robustness import command as robustness
+    from agents.robostrich.evaluate.policy_export import export_policy
     args = ["--plan", "robostrich/lesson2:300", "--hidden-sizes", "32,32", "--batch-size", "32",
             "--min-replay-size", "100", "--updates-per-call", "4", "--env-steps-per-call", "8",
             "--checkpoint-every", "100", "--no-figures", "--no-rerun", "--quiet", "--no-baseline"]
@@ -237,7 +238,7 @@ def test_the_command_writes_its_figure_json_and_a_results_record(tmp_path):
     (["robostrich", "--num-targets", "0"], "--num-targets"),
 ])
 def test_bad_input_is_one_line_and_exit_status_2(argv, message, tmp_path, capsys):
-    from agents.robostrich import robustness
+    from agents.robostrich.robustness import command as robustness
     try:
         status = robustness.cli(argv + ["--out", str(tmp_path / "out")])
     except SystemExit as stop:  # argparse's own exit, as the console script ends

@@ -14,7 +14,8 @@ import time
 
 import pytest
 
-from agents.robostrich import sweep_grid, sweep_table
+from agents.robostrich.sweep import grid as sweep_grid
+from agents.robostrich.sweep import table as sweep_table
 from conftest import COMMAND_ENVIRONMENT, console_script
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]

@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from agents.robostrich import sweep_grid
+from agents.robostrich.sweep import grid as sweep_grid
 from conftest import finish, start
 
 pytestmark = pytest.mark.usefixtures("shared_jax_cache")

@@ -9,9 +9,11 @@ import numpy as np
 import pytest
 
 from agents import checkpoint
-from agents.robostrich import main_job, training, training_progress
+from agents.robostrich.train import main_job
+from agents.robostrich.train import command as training
+from agents.robostrich.train import progress as training_progress
 from agents.curriculum import LessonSettings, format_plan
-from agents.robostrich.runs import DEFAULT_LESSONS, DomainRun, parse_plan
+from agents.robostrich.domain_run import DEFAULT_LESSONS, DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
 TINY = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=200, max_replay_size=5000,
@@ -214,7 +216,7 @@ def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
 def test_lesson_checkpoints_hold_the_policy_after_each_lesson(tmp_path):
     """--keep-lesson-checkpoints writes RUN/after_lessonK.ckpt at the end of every lesson but the
     last: a whole checkpoint of that moment, which robostrich-evaluate's loader restores."""
-    from agents.robostrich import evaluation
+    from agents.robostrich.evaluate import evaluation
     args = TINY_ARGS[:-1] + ["--plan", "point_mass/easy:300,point_mass/hard:300", "--no-baseline",
                              "--checkpoint-every", "1000", "--keep-lesson-checkpoints",
                              "--out", str(tmp_path)]

@@ -5,8 +5,8 @@ import os
 import numpy as np
 import pytest
 
-from agents.robostrich import evaluation
-from agents.robostrich.runs import DomainRun, parse_plan
+from agents.robostrich.evaluate import evaluation
+from agents.robostrich.domain_run import DomainRun, parse_plan
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 
@@ -40,7 +40,7 @@ def test_short_lesson1_training_improves_success_on_heldout_targets(tmp_path):
 
 @pytest.mark.long
 def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them(tmp_path, verify_rrd):
-    from agents.robostrich import training
+    from agents.robostrich.train import command as training
     out = str(tmp_path / "run")
     training.main(["--out", out, "--plan", "lesson1:250,lesson2:250,lesson3:250", "--hidden-sizes", "32,32",
                    "--batch-size", "32", "--min-replay-size", "100", "--checkpoint-every", "300",

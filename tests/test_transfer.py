@@ -1,4 +1,4 @@
-"""robostrich-train --init-from: an a1 run starts from a checkpoint of the arm on its frame (agents/robostrich/transfer.py).
+"""robostrich-train --init-from: an a1 run starts from a checkpoint of the arm on its frame (agents/robostrich/train/transfer.py).
 
 Real JAX and MuJoCo at tiny sizes: a 300-step robostrich run gives the checkpoint.
 """
@@ -13,8 +13,8 @@ from robostrich_suite.model import quadruped as quad
 from robostrich_suite.tasks import quadruped_tasks
 
 from agents import checkpoint
-from agents.robostrich import transfer
-from agents.robostrich.runs import DomainRun, parse_plan
+from agents.robostrich.train import transfer
+from agents.robostrich.domain_run import DomainRun, parse_plan
 from agents.sac.config import SACConfig
 from test_cli import assert_succeeded, assert_user_error, call, finish, start
 

@@ -139,8 +139,8 @@ def write_atomic(path: str, text: str) -> None:
 
 def train_and_evaluate(task, seed, steps, eval_at, config, args, progress, on_row):
     """One SAC run on `task`; `on_row(row)` after each deterministic evaluation."""
-    from agents.robostrich import evaluation
-    from agents.robostrich.runs import DomainRun, parse_plan
+    from agents.robostrich.evaluate import evaluation
+    from agents.robostrich.domain_run import DomainRun, parse_plan
     from agents.sac.builder import SACBuilder
     domain, task_name = task.split("/")
     run_dir = os.path.join(args.out, task.replace("/", "_"), f"seed_{seed}")

@@ -24,7 +24,7 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
-from agents.robostrich.runs import make_environment
+from agents.robostrich.domain_run import make_environment
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from agents.sac.learning import SACLearner, Transitions, init_state

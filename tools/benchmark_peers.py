@@ -8,7 +8,7 @@ Every run trains for --steps control steps on the main job's task options and la
 either on the final lesson alone ('final') or through the main job's lessons and shares
 ('lessons': the same agent and replay, the next lesson's environment); our curriculum goes
 through the lessons, our plain SAC trains the final lesson (robostrich-train at this budget).
-All are scored by agents/robostrich/evaluation.py: held-out success from the fixed start every
+All are scored by agents/robostrich/evaluate/evaluation.py: held-out success from the fixed start every
 --eval-every steps (the curves), then every held-out target from the fixed and from moving
 starts and `track`. --workers runs at a time, one core each; a finished run is not re-run, and
 --record-only writes the record from the runs finished so far.
@@ -22,7 +22,7 @@ import os
 import shlex
 import sys
 
-from agents.robostrich import peers  # needs no sbx to import
+from agents.robostrich.peers import sbx_agents as peers  # needs no sbx to import
 
 PROG = "benchmark_peers"
 AGENTS = ("curriculum", "plain", *peers.PEERS)
@@ -40,7 +40,7 @@ def _names(allowed):
 
 def build_parser():
     from robostrich_suite import cli as cli_lib
-    from agents.robostrich import evaluation
+    from agents.robostrich.evaluate import evaluation
     p = argparse.ArgumentParser(prog=PROG, description=__doc__.splitlines()[0], allow_abbrev=False)
     p.add_argument("--steps", type=cli_lib.whole_number(1, 100_000_000), default=100_000,
                    help="control steps of every run (default: %(default)s)")
@@ -78,7 +78,7 @@ def _names_int(text: str) -> tuple:
 
 
 def settings_from(args):
-    from agents.robostrich import peers_benchmark as bench
+    from agents.robostrich.peers import benchmark as bench
     from robostrich_suite import outputs
     outputs.check_directory(args.out)
     return bench.Settings(steps=args.steps, seeds=args.seeds, agents=args.agents, ways=args.ways, out=args.out,
@@ -90,7 +90,9 @@ def settings_from(args):
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     peers.require()  # before a minute of building: the one line says which extra
-    from agents.robostrich import evaluation, peers_benchmark as bench, peers_record
+    from agents.robostrich.evaluate import evaluation
+    from agents.robostrich.peers import benchmark as bench
+    from agents.robostrich.peers import record as peers_record
     settings = settings_from(args)
     results = bench.run_all(settings, args.workers, say=lambda line: print(f"{PROG}: {line}", flush=True),
                             train=not args.record_only)

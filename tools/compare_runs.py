@@ -6,7 +6,7 @@
 Each GROUP is ``LABEL=GLOB``: the glob names robostrich-train output directories (one per seed;
 their curriculum/evals.jsonl, config.json and summary.json are read). Writes a PNG (periodic
 held-out success and position error along training, final success per seed, the lookup's level
-dashed) and prints each group's final numbers as agents/robostrich/sweep_table.py tabulates them
+dashed) and prints each group's final numbers as agents/robostrich/sweep/table.py tabulates them
 (mean [min, max] over its seeds).
 """
 import argparse
@@ -16,8 +16,9 @@ import os
 
 import numpy as np
 
-from agents.robostrich import figures, sweep_table
-from agents.robostrich.runs import parse_plan
+from agents.robostrich import figures
+from agents.robostrich.sweep import table as sweep_table
+from agents.robostrich.domain_run import parse_plan
 
 KINDS = ("heldout", "heldout_moving")
 

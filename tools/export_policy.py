@@ -10,7 +10,7 @@ bounds, the model fingerprint and how the run was made (--command, its seed and 
 import os
 import sys
 
-from agents.robostrich.policy_export import export_policy
+from agents.robostrich.evaluate.policy_export import export_policy
 from robostrich_suite import cli as cli_lib
 
 

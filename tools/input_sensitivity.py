@@ -42,7 +42,7 @@ def build_parser():
 def measure(errors, every: int = 4, draws: int = 3, seed: int = 0) -> list:
     """One row per error size: episodes, success rate, median and 90th-percentile errors."""
     import robostrich_suite
-    from agents.robostrich import probes
+    from agents.robostrich import head_errors as probes
     from agents.robostrich.lookup import lookup_table, nearest
     from robostrich_suite import targets
     from tqdm import tqdm
@@ -95,7 +95,7 @@ def markdown(rows) -> str:
 
 def main(argv=None):
     args = build_parser().parse_args(argv)
-    from agents.robostrich import evaluation
+    from agents.robostrich.evaluate import evaluation
     from robostrich_suite import files
     rows = measure(args.errors, args.every, args.draws, args.seed)
     os.makedirs(args.out, exist_ok=True)

@@ -10,7 +10,8 @@ import argparse
 import sys
 
 from agents.replay import ObservationFlattener
-from agents.robostrich import evaluation, figures
+from agents.robostrich import figures
+from agents.robostrich.evaluate import evaluation
 from agents.robostrich.domains import TRACK_TASK, as_domain, domain_of
 from agents.robostrich.lookup import LookupPolicy
 from robostrich_suite import cli as cli_lib

@@ -15,21 +15,21 @@ INTERRUPTED = 130  # as robostrich_suite.cli.INTERRUPTED and TERMINATED, which t
 TERMINATED = 143
 
 COMMANDS = {
-    "robostrich-train": "agents.robostrich.training:cli",
-    "robostrich-evaluate": "agents.robostrich.evaluation:cli",
-    "robostrich-layouts": "agents.robostrich.layouts:cli",
-    "robostrich-stabilize": "agents.robostrich.application_commands:stabilize_cli",
-    "robostrich-gap": "agents.robostrich.application_commands:gap_cli",
-    "robostrich-play": "agents.robostrich.play:cli",
+    "robostrich-train": "agents.robostrich.train.command:cli",
+    "robostrich-evaluate": "agents.robostrich.evaluate.evaluation:cli",
+    "robostrich-layouts": "agents.robostrich.layout_comparison:cli",
+    "robostrich-stabilize": "agents.robostrich.applications.commands:stabilize_cli",
+    "robostrich-gap": "agents.robostrich.applications.commands:gap_cli",
+    "robostrich-play": "agents.robostrich.applications.play:cli",
     "robostrich-walk": "robostrich_suite.studies.walk:cli",
     "robostrich-export-xml": "robostrich_suite.xml_export:cli",
     "robostrich-movement": "robostrich_suite.studies.movement:cli",
     "robostrich-workspace": "robostrich_suite.studies.workspace:cli",
     "robostrich-targets": "robostrich_suite.studies.target_generation:cli",
     "robostrich-gait": "robostrich_suite.studies.gait_generation:cli",
-    "robostrich-sweep": "agents.robostrich.sweep:cli",
+    "robostrich-sweep": "agents.robostrich.sweep.command:cli",
     "robostrich-design": "robostrich_suite.studies.design:cli",
-    "robostrich-robustness": "agents.robostrich.robustness:cli",
+    "robostrich-robustness": "agents.robostrich.robustness.command:cli",
 }
 
 

@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.transforms as mtransforms  # noqa: E402
 import numpy as np  # noqa: E402
 
-from agents.robostrich import probes  # noqa: E402
+from agents.robostrich import head_errors as probes  # noqa: E402
 from robostrich_suite import files  # noqa: E402
 
 # A rate: always its whole range, so 0 % reads as 0 %; room above 1 for the lesson names.

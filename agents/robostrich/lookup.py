@@ -46,7 +46,7 @@ class LookupPolicy:
     """Holds the stored tendon inputs of the table pose nearest to the observed `target_position` (ties: first).
 
     `select_action(flat_obs)` takes the flattened observation (like the SAC
-    actors), so it plugs into agents.robostrich.evaluation; `flattener` (an
+    actors), so it plugs into agents.robostrich.evaluate.evaluation; `flattener` (an
     agents.replay.ObservationFlattener) says where `target_position` lies.
     """
 

@@ -103,7 +103,7 @@ def frame_to_trunk(frame_targets) -> np.ndarray:
 
 
 # The observations of these tasks in terms of ``robostrich``'s (the arm on its frame), for
-# starting a1 training from an agent trained on the frame (agents/robostrich/transfer.py).  Per key,
+# starting a1 training from an agent trained on the frame (agents/robostrich/train/transfer.py).  Per key,
 # the frame's (key, component) that each component equals, None for an input the frame
 # arm has not (the trunk's motion, the sideways 'left' component); keys not listed are the
 # frame's own, component by component.  On a standing, level quadruped at the nominal

@@ -28,7 +28,7 @@ from typing import Dict, Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from agents import checkpoint, trees
-from agents.robostrich.runs import named_layout, parse_plan
+from agents.robostrich.domain_run import named_layout, parse_plan
 from agents.sac.config import SACConfig
 from robostrich_suite.tasks import quadruped_tasks as qt
 

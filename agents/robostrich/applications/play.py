@@ -9,7 +9,11 @@ the recording in the browser until Ctrl-C (robostrich_suite/web_viewer.py).
 """
 import os
 
-from agents.robostrich import application_figures, applications, evaluation, figures, stabilization
+from agents.robostrich import figures
+from agents.robostrich.applications import figures as application_figures
+from agents.robostrich.applications import rollouts as applications
+from agents.robostrich.evaluate import evaluation
+from agents.robostrich.applications import stabilization
 from agents.robostrich.domains import as_domain, domain_of, TRACK_TASK
 from agents.robostrich.recording import open_recorder
 from robostrich_suite import outputs, policies, web_viewer

@@ -18,7 +18,7 @@ import sys
 import tempfile
 import threading
 import time
-from agents.robostrich.sweep_table import TIMING_FILE
+from agents.robostrich.sweep.table import TIMING_FILE
 from robostrich_suite.files import write_text
 
 INSTALL_HINT = "Ray is not installed; pip install -e '.[sweep]' (or pip install ray==2.60.0)"
@@ -27,7 +27,7 @@ INSTALL_HINT = "Ray is not installed; pip install -e '.[sweep]' (or pip install 
 # sockets/plasma_store (a second socket of one name gets .1, .2, ...).
 SOCKET_PATH_MAX = 107
 SOCKET_TAIL = 1 + 42 + len("/sockets/plasma_store") + 3
-# One intra-op thread per run, as robostrich-train's own workers have (agents/robostrich/training.py).
+# One intra-op thread per run, as robostrich-train's own workers have (agents/robostrich/train/command.py).
 ONE_THREAD_XLA = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
 INTERRUPT_GRACE_S = 300  # how long an interrupted run may take to write its checkpoints
 CONNECT_TIMEOUT_S = 10.0  # how long --address may stay silent before the sweep gives up
@@ -168,7 +168,7 @@ def train_command() -> str:
 
 def launch_command(argv: list) -> list:
     """The command line that runs robostrich-train with ``argv`` under the launcher
-    (agents/robostrich/run_launcher.py: Ctrl-C reaches the run, and the run writes its checkpoint
+    (agents/robostrich/sweep/run_launcher.py: Ctrl-C reaches the run, and the run writes its checkpoint
     and ends when the worker that started it dies)."""
     return [sys.executable, LAUNCHER, str(os.getpid()), train_command(), *argv]
 

@@ -19,18 +19,19 @@ import sys
 
 from agents import config_flags
 from agents.curriculum import format_plan, run_files
-from agents.robostrich import evaluation, figures, recording
+from agents.robostrich import figures, recording
+from agents.robostrich.evaluate import evaluation
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
-from agents.robostrich.main_job import (DEFAULT_ARM_LAYOUT, DEFAULT_ARM_TASK_KWARGS, DEFAULT_TOTAL_STEPS,
+from agents.robostrich.train.main_job import (DEFAULT_ARM_LAYOUT, DEFAULT_ARM_TASK_KWARGS, DEFAULT_TOTAL_STEPS,
                                         MAIN_JOB_CONFIG, MAIN_JOB_LESSON_SHARES, MAIN_JOB_STEPS,
                                         QUADRUPED_TASK_KWARGS, positive_int)
-from agents.robostrich.run_directory import check_run_directory, finished_summary, lock_run_directory, previous_init_path
-from agents.robostrich.runs import DEFAULT_LESSONS
-from agents.robostrich.training_input import TrainingSetup, json_object, prepare, randomize_scales
-from agents.robostrich.training_jobs import LookupSpec, RunJob, RunSpec, step_boundaries, final_targets, \
+from agents.robostrich.train.run_directory import check_run_directory, finished_summary, lock_run_directory, previous_init_path
+from agents.robostrich.domain_run import DEFAULT_LESSONS
+from agents.robostrich.train.checks import TrainingSetup, json_object, prepare, randomize_scales
+from agents.robostrich.train.jobs import LookupSpec, RunJob, RunSpec, step_boundaries, final_targets, \
     lesson_end_evaluations, read_jsonl, train_and_evaluate
-from agents.robostrich.training_progress import Progress
-from agents.robostrich.training_workers import train_in_parallel
+from agents.robostrich.train.progress import Progress
+from agents.robostrich.train.workers import train_in_parallel
 from agents.sac.config import SACConfig
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs
@@ -62,7 +63,7 @@ def _add_run_arguments(run) -> None:
                      help="start the curriculum's learner (policy, critics, target critics, optimiser states, "
                           "temperature) from a checkpoint.ckpt of robostrich-train on the same domain or, for "
                           "--domain robostrich_a1, on robostrich (the arm on its frame): its networks are mapped "
-                          "onto the a1's observations (agents/robostrich/transfer.py). Same tendon layout and networks "
+                          "onto the a1's observations (agents/robostrich/train/transfer.py). Same tendon layout and networks "
                           "(--hidden-sizes) required; the replay is not carried (other observations); the plain-SAC "
                           "baseline still starts from scratch, so the comparison shows what the transfer brings. "
                           "A --resume may leave it out (the checkpoint holds the transferred state)")
@@ -134,7 +135,7 @@ def add_agent_arguments(p) -> None:
     config_flags.add_config_arguments(p.add_argument_group("SAC (defaults: agents/sac/config.py)"), SACConfig(),
                                       MAIN_JOB_CONFIG)
     lessons = p.add_argument_group("per lesson (agents/curriculum.py LessonSettings; defaults: "
-                                   "agents/robostrich/runs.py DEFAULT_LESSONS)")
+                                   "agents/robostrich/domain_run.py DEFAULT_LESSONS)")
     config_flags.add_config_arguments(lessons, DEFAULT_LESSONS, MAIN_JOB_CONFIG)
     lessons.add_argument("--residual-scale", type=float, default=0.0,
                          help="train a residual on the lookup's stored inputs, within this fraction of each "

@@ -21,12 +21,13 @@ import numpy as np
 from agents import checkpoint
 from agents.curriculum import LessonSettings
 from agents.replay import ObservationFlattener
-from agents.robostrich import figures, probes
+from agents.robostrich import figures
+from agents.robostrich import head_errors as probes
 from agents.robostrich.domains import as_domain, domain_of, MOVING_START_TASK, TRACK_TASK
 from agents.robostrich.lookup import LABEL, LookupPolicy
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.robostrich.recording import open_recorder
-from agents.robostrich.runs import DomainRun, make_environment, parse_plan
+from agents.robostrich.domain_run import DomainRun, make_environment, parse_plan
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from robostrich_suite import files, outputs, parsing, web_viewer

@@ -1,7 +1,7 @@
 """What the two application evaluations (Sec. 5.2) share: the policies compared, the gait of
 each seed and a rollout that records what each evaluation asks for.
 
-Why one place: `head_stabilize` (agents/robostrich/stabilization.py) and `narrow_gap` (agents/robostrich/gap.py)
+Why one place: `head_stabilize` (agents/robostrich/applications/stabilization.py) and `narrow_gap` (agents/robostrich/applications/narrow_gap.py)
 compare the same policies on `robostrich_a1` -- a trained checkpoint, optionally a second
 one (e.g. lessons 1-3 without lesson 4), zero tendon input and the no-learning lookup
 (agents/robostrich/lookup.py) -- over the same seeds.
@@ -21,9 +21,9 @@ from typing import Callable, Optional
 import numpy as np
 
 from agents.replay import ObservationFlattener
-from agents.robostrich import probes
+from agents.robostrich import head_errors as probes
 from agents.robostrich.domains import as_domain, Domain
-from agents.robostrich.evaluation import load_run_from_checkpoint
+from agents.robostrich.evaluate.evaluation import load_run_from_checkpoint
 from agents.robostrich.lookup import LABEL, LookupPolicy
 from agents.robostrich.recording import open_recorder
 from agents.sac.builder import SACBuilder

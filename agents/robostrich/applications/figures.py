@@ -1,6 +1,6 @@
 """PNG figures of the application evaluations, as the paper's Fig. 9 and Fig. 12 (matplotlib, Agg).
 
-Both take the reports of agents/robostrich/stabilization.py / agents/robostrich/gap.py (label -> report with a
+Both take the reports of agents/robostrich/applications/stabilization.py / agents/robostrich/applications/narrow_gap.py (label -> report with a
 seed-0 `series`) and draw one line per policy; they return the Figure and write it when
 given a path.
 """
@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from robostrich_suite import files  # noqa: E402
-from agents.robostrich.gap import position_error
+from agents.robostrich.applications.narrow_gap import position_error
 
 COLORS = {"trained": "tab:blue", "reference": "tab:green", "zero": "tab:gray", "lookup": "tab:orange"}
 

@@ -14,9 +14,12 @@ import os
 
 import numpy as np
 
-from agents.robostrich import application_figures, applications, gap, stabilization
-from agents.robostrich.evaluation import write_json
-from agents.robostrich.stabilization import GOALS
+from agents.robostrich.applications import figures as application_figures
+from agents.robostrich.applications import rollouts as applications
+from agents.robostrich.applications import narrow_gap as gap
+from agents.robostrich.applications import stabilization
+from agents.robostrich.evaluate.evaluation import write_json
+from agents.robostrich.applications.stabilization import GOALS
 from robostrich_suite import outputs, progress, web_viewer
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.files import write_text

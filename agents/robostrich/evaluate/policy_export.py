@@ -8,8 +8,8 @@ import numpy as np
 
 from agents import checkpoint
 from agents.actors import ResidualAdapter
-from agents.robostrich.evaluation import default_heldout_task, load_run_from_checkpoint
-from agents.robostrich.runs import make_environment
+from agents.robostrich.evaluate.evaluation import default_heldout_task, load_run_from_checkpoint
+from agents.robostrich.domain_run import make_environment
 from robostrich_suite import policies
 from robostrich_suite import fingerprint as fingerprint_lib
 

@@ -8,15 +8,19 @@ Each run is robostrich-train itself (its training, checkpoints, evaluation and s
 SWEEP/runs/GROUP/seed_K, one core each; a group is one layout with one setting. A run whose
 summary.json exists is not run again, one with checkpoints is resumed (--resume); a run that fails
 is reported and the others go on. SWEEP/sweep.json and sweep.md hold mean [min, max] over seeds per
-group (agents/robostrich/sweep_table.py); tools/results_page.py add takes sweep.json.
+group (agents/robostrich/sweep/table.py); tools/results_page.py add takes sweep.json.
 """
 import argparse
 import json
 import os
 import sys
 
-from agents.robostrich import directory_lock, sweep_grid, sweep_ray, sweep_table
-from agents.robostrich import training, training_input  # robostrich-train's own parser and checks, for every group's flags
+from agents.robostrich import directory_lock
+from agents.robostrich.sweep import grid as sweep_grid
+from agents.robostrich.sweep import ray_tasks as sweep_ray
+from agents.robostrich.sweep import table as sweep_table
+from agents.robostrich.train import command as training
+from agents.robostrich.train import checks as training_input  # robostrich-train's own parser and checks, for every group's flags
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs, parsing
 from robostrich_suite.files import write_text
@@ -43,7 +47,7 @@ def build_parser():
                               "after the grid file's. --seed, --out, --resume and --workers are set for each run.")
     p.add_argument("--grid", metavar="FILE", default=None,
                    help="TOML grid file: seeds, layouts, [train] flags of every run, [settings.NAME] flags of "
-                        "each group (agents/robostrich/sweep_grid.py)")
+                        "each group (agents/robostrich/sweep/grid.py)")
     p.add_argument("--seeds", type=_comma_list(cli_lib.seed), default=None,
                    help="comma-separated seeds, over the grid file's (default: the grid file's, else 0,1,2)")
     p.add_argument("--layouts", type=_comma_list(str), default=None,

@@ -5,9 +5,9 @@ import os
 import queue as queue_lib
 import signal
 
-from agents.robostrich import evaluation
-from agents.robostrich.training_jobs import LookupSpec, RunJob, RunSpec, train_and_evaluate
-from agents.robostrich.training_progress import QueueProgress
+from agents.robostrich.evaluate import evaluation
+from agents.robostrich.train.jobs import LookupSpec, RunJob, RunSpec, train_and_evaluate
+from agents.robostrich.train.progress import QueueProgress
 from robostrich_suite import cli as cli_lib
 
 

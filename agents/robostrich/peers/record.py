@@ -5,7 +5,8 @@ show the same numbers, mean and [min, max] over the seeds of one command.
 """
 import numpy as np
 
-from agents.robostrich import peers, peers_benchmark as bench
+from agents.robostrich.peers import sbx_agents as peers
+from agents.robostrich.peers import benchmark as bench
 
 
 def run_name(label: str) -> str:

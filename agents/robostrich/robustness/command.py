@@ -15,7 +15,8 @@ import os
 
 
 from agents.replay import ObservationFlattener
-from agents.robostrich import evaluation, robustness_figure
+from agents.robostrich.evaluate import evaluation
+from agents.robostrich.robustness import figure as robustness_figure
 from agents.robostrich.domains import as_domain, Domain, domain_of
 from agents.robostrich.lookup import LABEL, LookupPolicy
 from agents.sac.builder import SACBuilder

@@ -10,10 +10,11 @@ from typing import Optional
 import numpy as np
 
 from agents.curriculum import read_records
-from agents.robostrich import evaluation, transfer
+from agents.robostrich.evaluate import evaluation
+from agents.robostrich.train import transfer
 from agents.robostrich.domains import Domain
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
-from agents.robostrich.runs import DomainRun
+from agents.robostrich.domain_run import DomainRun
 from agents.sac.builder import SACBuilder
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import files
@@ -43,7 +44,7 @@ class RunSpec:
     """A run not built yet (picklable): ``DomainRun``'s own keyword arguments, the one description
     of a run, so that the parent of a parallel job passes it to a worker instead of building the
     run (networks, replay, environment) itself, which it would only throw away. ``transfer_from``:
-    a checkpoint a fresh run's learner starts from (agents/robostrich/transfer.py; its content
+    a checkpoint a fresh run's learner starts from (agents/robostrich/train/transfer.py; its content
     hash is the run's ``init_from``)."""
 
     arguments: dict

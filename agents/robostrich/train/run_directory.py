@@ -6,9 +6,10 @@ from typing import Optional
 
 from agents import checkpoint
 from agents.curriculum import read_records, run_files
-from agents.robostrich import directory_lock, transfer
-from agents.robostrich.runs import run_identity
-from agents.robostrich.training_input import TrainingSetup
+from agents.robostrich import directory_lock
+from agents.robostrich.train import transfer
+from agents.robostrich.domain_run import run_identity
+from agents.robostrich.train.checks import TrainingSetup
 from robostrich_suite import parsing
 
 

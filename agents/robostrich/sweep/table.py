@@ -31,7 +31,7 @@ def _stats(values):
 def aggregate(summaries, seeds=None, minutes=None) -> dict:
     """Mean, min and max over seeds of each run's evaluation metrics.
 
-    `summaries` are the seeds' summary.json dicts (agents/robostrich/training.py: summary["runs"][label][kind]);
+    `summaries` are the seeds' summary.json dicts (agents/robostrich/train/command.py: summary["runs"][label][kind]);
     `seeds` and `minutes` (wall-clock per seed, None where unknown) go into the result as given.
     """
     if not summaries:

@@ -15,7 +15,7 @@ from typing import Optional
 
 import numpy as np
 
-from agents.robostrich import applications
+from agents.robostrich.applications import rollouts as applications
 
 TASK = "head_stabilize"
 SETTLE = 1.0  # s excluded from the metrics at the episode start (module doc)

@@ -21,7 +21,7 @@ from typing import Optional
 import mujoco
 import numpy as np
 
-from agents.robostrich import applications
+from agents.robostrich.applications import rollouts as applications
 from robostrich_suite import scenes
 from robostrich_suite.physics import arm_ids, arm_indices
 

@@ -15,7 +15,7 @@ from typing import Optional
 import numpy as np
 
 from agents.replay import ObservationFlattener
-from agents.robostrich import evaluation
+from agents.robostrich.evaluate import evaluation
 from agents.robostrich.domains import Domain
 
 PEERS = {"sac": "SAC", "tqc": "TQC", "crossq": "CrossQ"}  # flag name -> sbx class

@@ -10,10 +10,10 @@ import numpy as np
 
 import robostrich_suite
 from agents.replay import ObservationFlattener
-from agents.robostrich import evaluation
+from agents.robostrich.evaluate import evaluation
 from agents.robostrich.lookup import lookup_table, LookupPolicy
-from agents.robostrich.main_job import FIXED_START_ARM_TASK_KWARGS
-from agents.robostrich.runs import DomainRun, make_environment, parse_plan
+from agents.robostrich.train.main_job import FIXED_START_ARM_TASK_KWARGS
+from agents.robostrich.domain_run import DomainRun, make_environment, parse_plan
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from robostrich_suite import targets

@@ -3,7 +3,7 @@
 Why one command: a ratio such as "our curriculum reaches 95 % in X steps, the best peer in Y"
 means something only when both come from the same run on the same machine, budget and seeds.
 Our curriculum SAC and plain SAC are robostrich-train runs (the main job's defaults, at this
-budget); the lookup is evaluated once; the peers are agents/robostrich/peers.py.
+budget); the lookup is evaluated once; the peers are agents/robostrich/peers/sbx_agents.py.
 """
 import contextlib
 import dataclasses
@@ -15,7 +15,10 @@ from typing import Optional
 import numpy as np
 
 from agents.curriculum import Lesson, read_records
-from agents.robostrich import evaluation, main_job, peers, training
+from agents.robostrich.evaluate import evaluation
+from agents.robostrich.train import main_job
+from agents.robostrich.peers import sbx_agents as peers
+from agents.robostrich.train import command as training
 from agents.robostrich.domains import Domain
 
 DOMAIN = "robostrich"

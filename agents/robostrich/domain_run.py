@@ -5,7 +5,8 @@ from typing import Callable, Optional, Sequence
 
 from agents import curriculum
 from agents.curriculum import Lesson, LessonSettings
-from agents.robostrich import environment_state, probes
+from agents.robostrich import environment_state
+from agents.robostrich import head_errors as probes
 from agents.robostrich.domains import as_domain, Domain
 from agents.robostrich.lookup import LookupPolicy
 from agents.sac.config import SACConfig
@@ -54,7 +55,7 @@ def identity_extra(plan, task_kwargs: Optional[dict] = None, layout: Optional[st
                    init_from: Optional[str] = None, residual_scale: float = 0.0) -> dict:
     """What a run's fingerprint holds beside config, lesson settings, plan and seed: the task options,
     the layout by name, ``init_from`` (the content hash of the checkpoint the run started from,
-    agents/robostrich/transfer.py) and a residual policy's scale."""
+    agents/robostrich/train/transfer.py) and a residual policy's scale."""
     extra = {}
     if residual_scale:
         extra["residual_scale"] = float(residual_scale)

@@ -6,10 +6,10 @@ import json
 from typing import Optional
 
 from agents.curriculum import Lesson, LessonSettings
-from agents.robostrich import evaluation
+from agents.robostrich.evaluate import evaluation
 from agents.robostrich.domains import Domain
-from agents.robostrich.main_job import config_from_args, plan_from_args, resolve_layout, resolve_task_kwargs, with_flags
-from agents.robostrich.runs import check_lesson_names
+from agents.robostrich.train.main_job import config_from_args, plan_from_args, resolve_layout, resolve_task_kwargs, with_flags
+from agents.robostrich.domain_run import check_lesson_names
 from agents.sac.config import SACConfig
 from robostrich_suite import parsing
 from robostrich_suite.tasks import perturbations
