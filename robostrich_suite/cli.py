@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import gc
 import math
 import signal
 import sys
@@ -72,11 +73,23 @@ def raise_if_interrupted() -> None:
 
 
 def _on_sigint(signum, frame):
-    """Ctrl-C or SIGTERM: a KeyboardInterrupt now, or a flag for the loop inside `deferred_interrupts`."""
+    """Ctrl-C or SIGTERM: a KeyboardInterrupt now, or a flag for the loop inside `deferred_interrupts`;
+    only the flag inside a garbage-collection callback (JAX's), where Python would print the
+    exception as ignored and go on: the next `raise_if_interrupted` acts on it."""
     global _interrupted, _signal
     _interrupted, _signal = True, signum
-    if not _deferred:
+    if not _deferred and not _in_gc_callback(frame):
         raise KeyboardInterrupt
+
+
+def _in_gc_callback(frame) -> bool:
+    """Whether ``frame`` runs inside one of ``gc.callbacks``."""
+    codes = {getattr(callback, "__code__", None) for callback in gc.callbacks}
+    while frame is not None:
+        if frame.f_code in codes:
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _install(handler) -> dict:

@@ -9,6 +9,7 @@ import os
 import pathlib
 import signal
 import subprocess
+import sys
 import threading
 import time
 
@@ -181,3 +182,30 @@ def test_a_command_stopped_mid_recording_leaves_no_recording(tmp_path):
         assert_stopped(command, 130, "interrupted")
         out = tmp_path / name
         assert not out.exists() or os.listdir(out) == [], os.listdir(out)
+
+
+GC_CALLBACK_STOP = """
+import gc, signal
+from robostrich_suite import cli
+cli._install(cli._on_sigint)
+def callback(phase, info):  # as JAX's: Python runs it from the collector and ignores what it raises
+    if phase == "start":
+        signal.raise_signal(signal.SIGINT)
+gc.callbacks.append(callback)
+gc.collect()
+gc.callbacks.remove(callback)
+print("interrupted", cli.interrupted())
+try:
+    cli.raise_if_interrupted()
+except KeyboardInterrupt:
+    print("acted on")
+"""
+
+
+def test_ctrl_c_inside_a_garbage_collection_callback_is_kept_for_the_loop_not_printed_as_ignored():
+    """Ctrl-C landing in a gc callback (JAX registers one) only sets the flag: raised there,
+    Python would print 'Exception ignored in ...' above the command's one line."""
+    result = subprocess.run([sys.executable, "-c", GC_CALLBACK_STOP], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert result.stdout.split("\n")[:2] == ["interrupted True", "acted on"], result.stdout
+    assert "Exception ignored" not in result.stderr, result.stderr[-3000:]

@@ -8,19 +8,24 @@ import textwrap
 from typing import Dict, List
 
 import matplotlib
+import matplotlib.pyplot as plt
+import matplotlib.transforms as mtransforms
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import matplotlib.transforms as mtransforms  # noqa: E402
-import numpy as np  # noqa: E402
-
-from agents.robostrich import head_errors as probes  # noqa: E402
-from robostrich_suite import files  # noqa: E402
+from agents.robostrich import head_errors as probes
+from robostrich_suite import files
 
 # A rate: always its whole range, so 0 % reads as 0 %; room above 1 for the lesson names.
 SUCCESS_LIMITS = (-0.03, 1.1)
 # How a figure names the runs of robostrich-train (its run directories' labels)
 RUN_NAMES = {"curriculum": "curriculum SAC", "baseline": "plain SAC (final lesson only)", "lookup": "lookup (no learning)"}
+
+def _subplots(*args, **kwargs):
+    """``plt.subplots`` drawing into files (Agg), chosen at plot time: importing this module must
+    not switch a notebook's backend."""
+    matplotlib.use("Agg")
+    return plt.subplots(*args, **kwargs)
+
 
 
 def _smooth(x, n):
@@ -86,7 +91,7 @@ def learning_curves_figure(runs: Dict[str, List[dict]], evals: Dict[str, List[di
     clear, held-out against held-out.
     Domains without position errors (e.g. reacher) show the evaluation return instead.
     """
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    fig, axes = _subplots(1, 3, figsize=(15, 4.6))
     labels = list(dict.fromkeys(list(runs) + list(evals or {}) + list(baselines or {})))
     color = {label: f"C{i}" for i, label in enumerate(labels)}
     last_step = 0
@@ -200,7 +205,7 @@ def track_figure(reports: Dict[str, dict], notes: Dict[str, str] = None):
     """Fig. 7a, c, d: (a) head path, (b) position error and (c) head attitude over the `track` task.
     Each run's legend entry says how many targets it reached (the goal: all); ``notes`` (label ->
     text, e.g. its seed and budget) are added to its name."""
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    fig, axes = _subplots(1, 3, figsize=(15, 4.6))
     runs = {}  # legend label -> its line in (b)
     for i, (label, report) in enumerate(reports.items()):
         s = report["series"]
@@ -262,7 +267,7 @@ def seed_groups_figure(groups: Dict[str, List[dict]], lookup: Dict[str, float] =
     "final": {kind: summary}}`` (kind ``heldout`` and optionally ``heldout_moving``);
     ``lookup``: kind -> the lookup's final success rate, drawn dashed (the bar to clear).
     """
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), gridspec_kw={"width_ratios": [1.2, 1.2, 1.0]})
+    fig, axes = _subplots(1, 3, figsize=(15, 4.6), gridspec_kw={"width_ratios": [1.2, 1.2, 1.0]})
     last_step = 0
     for index, (label, seeds) in enumerate(groups.items()):
         last_step = max(last_step, _plot_seed_curves(axes[:2], label, seeds, f"C{index}"))

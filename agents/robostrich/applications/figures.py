@@ -7,13 +7,11 @@ given a path.
 from typing import Optional
 
 import matplotlib
+import matplotlib.patches as mpatches
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.patches as mpatches  # noqa: E402
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from robostrich_suite import files  # noqa: E402
+from robostrich_suite import files
 from agents.robostrich.applications.narrow_gap import position_error
 
 COLORS = {"trained": "tab:blue", "reference": "tab:green", "zero": "tab:gray", "lookup": "tab:orange"}
@@ -69,6 +67,7 @@ def stabilization_figure(reports: dict, path: Optional[str] = None, settle: floa
     (D) head attitude with the desired band; trunk-height ramps shaded grey, the unscored
     first `settle` seconds hatched (B's scale ignores them: the arm's first fall is fast).
     Each policy's legend entry gives its worst seed's metric of that panel against its goal."""
+    matplotlib.use("Agg")  # files, never a window (at plot time: importing must not switch a notebook's backend)
     fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
     first = next(iter(reports.values()))["series"]
     for ax in axes:
@@ -111,6 +110,7 @@ def gap_figure(reports: dict, scene: dict, targets, position_tolerance: float,
                path: Optional[str] = None):
     """Fig. 12: (A) head path in the x-z plane with wall, shelf, slot and sub-targets;
     (B) position error and (C) head attitude over time, sub-target switches marked."""
+    matplotlib.use("Agg")  # files, never a window (at plot time: importing must not switch a notebook's backend)
     fig = plt.figure(figsize=(11, 8))
     grid = fig.add_gridspec(2, 2, width_ratios=[1, 1.3])
     path_ax = fig.add_subplot(grid[:, 0])

@@ -2,11 +2,9 @@
 per evaluated policy (the policy, a compared one, the lookup) and one row per start (fixed,
 moving), so the policy and the baseline sit side by side on the same axes' scale."""
 import matplotlib
+import matplotlib.pyplot as plt
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from robostrich_suite import files  # noqa: E402
+from robostrich_suite import files
 
 TITLES = {"heldout": "held-out, fixed start", "heldout_moving": "held-out, moving starts"}
 
@@ -15,6 +13,7 @@ def plot(report: dict, path) -> None:
     """robustness.png from the robustness.json ``report``."""
     labels = report["labels"]
     kinds = [k for k in TITLES if any(k in rows[0] for rows in report["results"][labels[0]].values())]
+    matplotlib.use("Agg")  # files, never a window (at plot time: importing must not switch a notebook's backend)
     fig, axes = plt.subplots(len(kinds), len(labels), figsize=(4.2 * len(labels), 3.4 * len(kinds)),
                              sharex=True, sharey=True, squeeze=False)
     colours = plt.get_cmap("tab10")
