@@ -87,7 +87,6 @@ class GoalRelabeler:
         taken = np.arange(substep_goals.shape[-2]) < substeps[..., None]
         return np.sum(np.where(taken, per_step, 0.0), axis=-1)
 
-
     def goal_free(self, reward: float, substep_goals, flat_obs: np.ndarray) -> float:
         """The part of ``reward`` that ``goal_reward`` does not give: the stored reward of a
         transition from ``flat_obs`` whose control steps reached ``substep_goals``, less its goal's."""

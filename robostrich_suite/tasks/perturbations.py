@@ -193,7 +193,7 @@ class Perturber(Randomizer):
             self._latency = (int(stream["latency"].randint(0, latency_steps(c.latency) + 1)) if c.latency else 0)
             drawn["scale"] = {f: scale[f] for f in c.active()}
             drawn["latency_steps"] = self._latency
-        c = dataclasses.replace(c, **scale)
+            c = dataclasses.replace(c, **scale)
         self._joint_noise = c.joint_noise
 
         def factors(family, size):

@@ -289,12 +289,13 @@ class Reach(base.Task):
 
     def _set_action(self, action, physics) -> None:
         controls = physics.arm_control_view()
-        if self._sent_actions is not None:  # the observation's memory of what was sent
+        if self._sent_actions is not None or self.randomizer is not None:
             action = check_action(action, physics.arm_control_bounds())
+        if self._sent_actions is not None:  # the observation's memory of what was sent
             self._sent_actions[1:] = self._sent_actions[:-1]
             self._sent_actions[0] = action
         if self.randomizer is not None:  # an action may reach the servos late (tasks.perturbations)
-            action = self.randomizer.delayed(check_action(action, physics.arm_control_bounds()))
+            action = self.randomizer.delayed(action)
         if controls is None:
             physics.set_arm_control(check_action(action, physics.arm_control_bounds()))
         else:  # checked and clipped straight into the simulation's controls
@@ -393,10 +394,9 @@ class Reach(base.Task):
         obs["head_attitude"] = np.array([math.radians(attitude)])
         obs["tendon_contraction"] = physics.tendon_contractions()
         obs["tendon_tension"] = physics.tendon_tensions()
-        if self.observe_sent_actions:
-            sent = self._sent_actions
-            obs["sent_actions"] = (np.tile(physics.arm_control(), self.observe_sent_actions) if sent is None
-                                   else sent.ravel().copy())
+        if self.observe_sent_actions:  # before the first episode: the inputs the servos hold
+            obs["sent_actions"] = (np.tile(physics.arm_control(), self.observe_sent_actions)
+                                   if self._sent_actions is None else self._sent_actions.ravel().copy())
         return obs
 
     def get_reward(self, physics):
