@@ -221,11 +221,13 @@ def _parse(content: memoryview) -> dict:
                 "payload": _decode(header.get("payload"), arrays)}
 
 
-def load(path: str, fingerprint: dict = None) -> dict:
-    """Returns the payload; raises CheckpointError if damaged or if `fingerprint` differs from the stored one."""
+def load(path: str, fingerprint: dict = None, current=None) -> dict:
+    """Returns the payload; raises CheckpointError if damaged or if `fingerprint` differs from the stored one
+    (read through ``current(stored)`` where given: an older fingerprint as this version writes it)."""
     record = _read_record(path)
     if fingerprint is not None:
-        check_fingerprint(record["fingerprint"], fingerprint, path)
+        stored = record["fingerprint"]
+        check_fingerprint(current(stored) if current is not None else stored, fingerprint, path)
     return record["payload"]
 
 

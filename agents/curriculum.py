@@ -137,6 +137,17 @@ def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, lessons: 
             "plan": format_plan(plan), "seed": seed, **(extra or {})}
 
 
+def current_fingerprint(stored: dict) -> dict:
+    """A checkpoint's fingerprint as this version writes it for the same run: a field SACConfig no
+    longer has is dropped where it holds the value that now goes without saying
+    (SACConfig.REMOVED_FIELDS; another value stays, and then no run matches it)."""
+    config = stored.get("config")
+    if not isinstance(config, dict):
+        return stored
+    removed = SACConfig.REMOVED_FIELDS
+    return {**stored, "config": {k: v for k, v in config.items() if not (k in removed and v == removed[k])}}
+
+
 def run_files(run_dir: str) -> Tuple[str, str, str]:
     """A run directory's checkpoint, per-episode metrics and periodic evaluations."""
     return (os.path.join(run_dir, checkpoint.FILE_NAME), os.path.join(run_dir, "metrics.jsonl"),
@@ -249,6 +260,9 @@ class CurriculumRun:
         """What the fingerprint holds beside config, plan and seed (``identity``, by default)."""
         return self.identity
 
+    # A stored fingerprint as this version writes it, before a restore compares it with the run's.
+    current_fingerprint = staticmethod(current_fingerprint)
+
     def state_dict(self) -> dict:
         loop = self.loop
         environment = None
@@ -278,7 +292,7 @@ class CurriculumRun:
 
     def restore(self, path: Optional[str] = None):
         path = path or self.checkpoint_path
-        state = checkpoint.load(path, self.fingerprint())
+        state = checkpoint.load(path, self.fingerprint(), self.current_fingerprint)
         missing = [k for k in self.STATE_FIELDS if k not in state]
         if missing:
             raise checkpoint.CheckpointError(f"{path} lacks the run state {missing} (not written by a CurriculumRun)")

@@ -113,8 +113,7 @@ class EnvironmentLoop:
             self.transitions += 1
             if self.transitions % cfg.env_steps_per_call == 0 and len(replay) >= cfg.min_replay_size:
                 batches = replay.sample_stack(cfg.updates_per_call, cfg.batch_size, relabeler,
-                                              self.her_ratio, cfg.relabel_rewards,
-                                              getattr(cfg, "her_level_goals", False))
+                                              self.her_ratio, cfg.relabel_rewards)
                 self.latest_metrics = self.learner.step(batches)
                 self.actor.update(self.learner.policy_params)
             if timestep.last():

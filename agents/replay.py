@@ -115,16 +115,16 @@ class ReplayBuffer:
         self.episode_start = self.total_added
 
     def sample_stack(self, num_batches: int, batch_size: int, relabeler=None, her_ratio: float = 0.0,
-                     relabel_rewards: bool = False, settable_goals_only: bool = False) -> Transitions:
+                     relabel_rewards: bool = False) -> Transitions:
         """num_batches independent uniform batches, shaped [num_batches, batch_size, ...].
 
         With a ``relabeler`` (agents/goals.py), a ``her_ratio`` share of the rows get as goal
         the position reached at a uniformly drawn later step of the same episode ("future"
         strategy), and their rewards are recomputed; ``relabel_rewards`` recomputes every
         row's reward with the relabeler's (the current lesson's) reward function. Rows that
-        ended in a divergence (discount 0) keep their stored penalty. ``settable_goals_only``
-        relabels a row only when the later pose is a goal the task could set (within the
-        task's attitude tolerance where its reward asks for one, ``GoalRelabeler.settable``); the others keep theirs.
+        ended in a divergence (discount 0) keep their stored penalty. Where the task limits the
+        goals it could set (``GoalRelabeler.settable``), a row is relabelled only when the later
+        pose is one of them; the others keep theirs.
         """
         if self.size == 0:
             raise ValueError("cannot sample from an empty replay buffer")
@@ -143,8 +143,9 @@ class ReplayBuffer:
             future = first + np.floor(self.rng.random(idx.shape) * (last - first + 1)).astype(np.int64)
             rows = self._rows(future)
             reached_pose = self.substep_goals[rows, self.substeps[rows] - 1]
-            if settable_goals_only:
-                her &= relabeler.settable(reached_pose)
+            settable = relabeler.settable(reached_pose)
+            if settable is not None:
+                her &= settable
             reached = reached_pose[..., :relabeler.goal_size]
             goal = np.where(her[..., None], reached, goal)
             obs[her] = relabeler.with_goal(obs[her], goal[her])

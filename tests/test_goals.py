@@ -163,30 +163,33 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
 
 
 def test_level_goals_only_relabel_with_poses_the_lesson_could_set(run):
-    """her_level_goals: a row gets a later pose as its goal only if that pose's head was within
-    the attitude tolerance (a target lesson 2 could set); the others keep their own target.
-    Lesson 1 (eq. 9 ignores the attitude) may relabel with every reached position."""
+    """The reaching tasks' option hindsight_level_goals: a row gets a later pose as its goal only if
+    that pose's head was within the attitude tolerance (a target lesson 2 could set); the others
+    keep their own target. Lesson 1 (eq. 9 ignores the attitude), and every lesson without the
+    option, may relabel with every reached position."""
     import robostrich_suite
-    replay, relabeler = run.loop.replay, run.loop.relabeler
-    assert relabeler.goal_attitude_tolerance == 5.0  # lesson 2's own tolerance
-    lesson1 = robostrich_suite.load("robostrich", "lesson1").task
-    assert lesson1.goal_attitude_tolerance() is None
+    replay, relabeler, task = run.loop.replay, run.loop.relabeler, run.loop.env.task
     n = len(replay)
-    attitude = np.abs(replay.substep_goals[:n, -1, 2])
+    reached = replay.substep_goals[:n, -1]
+    assert relabeler.settable(reached) is None  # the option is off by default
+    level = {"hindsight_level_goals": True}
+    assert robostrich_suite.load("robostrich", "lesson1", task_kwargs=level).task.settable_goals(reached) is None
+    assert robostrich_suite.load("robostrich", "lesson2", task_kwargs=level).task.attitude_tolerance == 5.0
+    attitude = np.abs(reached[:, 2])
     # The random policy rarely holds the head level: judge against the median attitude error
     # instead, so that about half the reached poses count as settable goals.
-    relabeler.goal_attitude_tolerance = float(np.median(attitude))
+    saved = task.attitude_tolerance
+    task.hindsight_level_goals, task.attitude_tolerance = True, float(np.median(attitude))
     try:
-        batch = replay.sample_stack(1, 400, relabeler, her_ratio=1.0, settable_goals_only=True)
+        batch = replay.sample_stack(1, 400, relabeler, her_ratio=1.0)
     finally:
-        relabeler.goal_attitude_tolerance = 5.0
+        task.hindsight_level_goals, task.attitude_tolerance = False, saved
     goals = batch.obs[0][:, relabeler.goal]
-    reached = replay.substep_goals[:n, -1]
     kept = relabelled = 0
     for goal in goals:
         match = np.flatnonzero(np.all(reached[:, :2] == goal, axis=1))
         if match.size:  # a reached position: it must have been a settable one
-            assert np.any(np.abs(reached[match, 2]) <= np.median(attitude))
+            assert np.any(attitude[match] <= np.median(attitude))
             relabelled += 1
         else:
             assert np.any(np.all(replay.obs[:n, relabeler.goal] == goal, axis=1))  # its own target
@@ -214,7 +217,7 @@ def test_a_goal_the_achieved_observation_cannot_be_compared_with_is_refused():
     flattener = ObservationFlattener(env.observation_spec())
     type(env.task).ACHIEVED_COMPONENTS, saved = None, type(env.task).ACHIEVED_COMPONENTS
     try:
-        with pytest.raises(ValueError, match="ACHIEVED_COMPONENTS"):
+        with pytest.raises(ValueError, match="achieved_components"):
             GoalRelabeler.for_environment(env, flattener)
     finally:
         type(env.task).ACHIEVED_COMPONENTS = saved

@@ -201,9 +201,9 @@ def test_paper_sac_flag_gives_acme_defaults_under_explicit_flags():
     assert config == SACConfig.paper_sac(batch_size=32)
     assert not config.critic_layer_norm and config.her_ratio == 0 and config.init_temperature == 1.0
     default = main_job.config_from_args(training.build_parser().parse_args(["--domain", "reacher"]), [])
-    assert default == SACConfig()  # the CLI's defaults are the dataclass's, under the main job's on robostrich
+    assert default == main_job.MAIN_JOB_SAC  # the CLI's defaults are the main job's, on every domain
     arm = main_job.config_from_args(training.build_parser().parse_args([]), [], LessonSettings)
-    assert arm == dataclasses.replace(DEFAULT_LESSONS, **main_job.MAIN_JOB_CONFIG["robostrich"])
+    assert arm == dataclasses.replace(DEFAULT_LESSONS, **main_job.MAIN_JOB_LESSONS["robostrich"])
     paper = main_job.config_from_args(args, ["--paper-sac", "--batch-size", "32"], LessonSettings)
     assert paper == LessonSettings()  # nothing per lesson
     argv = ["--her-ratio", "0.5", "--her-lessons", "lesson1,lesson2", "--hidden-sizes", "32,16"]
@@ -239,12 +239,11 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
     arm's settings, and the paper's routing and eq. 10 stay one flag away."""
     from agents.robostrich.domains import Domain
     arm, dmc = Domain("robostrich"), Domain("reacher")
-    config = SACConfig()
+    config = main_job.MAIN_JOB_SAC
     assert config.resolved_target_entropy(9) == -18.0 and SACConfig.paper_sac().resolved_target_entropy(9) == -9.0
     assert SACConfig(target_entropy=-3.0).resolved_target_entropy(9) == -3.0  # an explicit value wins
     assert [DEFAULT_LESSONS.her_ratio(t, config) for t in ("lesson1", "lesson2", "lesson3", "lesson4")] == [
         0.5, 0.0, 0.0, 0.0]
-    assert not config.her_level_goals and not SACConfig.paper_sac().her_level_goals
     assert main_job.resolve_layout(None, arm) == "ventral_slips" == arm.layout  # the tasks' own, by name
     assert main_job.resolve_layout("antagonist_pairs", arm) == "antagonist_pairs"
     assert main_job.resolve_layout(None, dmc) is None and dmc.layout is None

@@ -177,15 +177,16 @@ def main(argv=None) -> int:
         if args.eval_episodes <= 0:
             raise ValueError("--eval-episodes must be positive")
         settings = {t: task_settings(args, t) for t in tasks}
-        from agents.sac.config import SACConfig
-        configs = {t: SACConfig(batch_size=args.batch_size, learning_rate=args.learning_rate,
-                                hidden_sizes=tuple(int(h) for h in args.hidden_sizes.split(",") if h),
-                                min_replay_size=args.min_replay_size, updates_per_call=args.updates_per_call,
-                                env_steps_per_call=args.env_steps_per_call, action_repeat=settings[t][1],
-                                critic_layer_norm=args.critic_layer_norm, init_temperature=args.init_temperature,
-                                target_entropy_per_action=args.target_entropy_per_action,
-                                pre_tanh_penalty=args.pre_tanh_penalty,
-                                her_ratio=0.0) for t in tasks}
+        import dataclasses
+        from agents.robostrich.train.main_job import MAIN_JOB_SAC  # robostrich-train's agent, these flags on top
+        configs = {t: dataclasses.replace(MAIN_JOB_SAC, batch_size=args.batch_size, learning_rate=args.learning_rate,
+                                          hidden_sizes=tuple(int(h) for h in args.hidden_sizes.split(",") if h),
+                                          min_replay_size=args.min_replay_size, updates_per_call=args.updates_per_call,
+                                          env_steps_per_call=args.env_steps_per_call, action_repeat=settings[t][1],
+                                          critic_layer_norm=args.critic_layer_norm, init_temperature=args.init_temperature,
+                                          target_entropy_per_action=args.target_entropy_per_action,
+                                          pre_tanh_penalty=args.pre_tanh_penalty,
+                                          her_ratio=0.0) for t in tasks}
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

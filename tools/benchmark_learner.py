@@ -16,6 +16,7 @@ Variants are measured in interleaved rounds, best round kept, so that other
 load on the machine biases the ratios as little as possible.
 """
 import argparse
+import dataclasses
 import sys
 import time
 
@@ -25,6 +26,7 @@ import numpy as np
 import optax
 
 from agents.robostrich.domain_run import make_environment
+from agents.robostrich.train.main_job import MAIN_JOB_SAC
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from agents.sac.learning import SACLearner, Transitions, init_state
@@ -121,10 +123,11 @@ def main(argv=None):
     p.add_argument("--json", default=None, help="also write the rates and ratios here (a results record's input)")
     args = p.parse_args(argv)
     env = make_environment(args.domain, args.task, 0)
-    config = SACConfig(batch_size=args.batch, hidden_sizes=tuple(int(h) for h in args.hidden_sizes.split(",")),
-                       updates_per_call=args.updates_per_call, min_replay_size=0,
-                       # the same computation as the plain implementation it is compared with
-                       critic_layer_norm=False, her_ratio=0.0, relabel_rewards=False)
+    config = dataclasses.replace(MAIN_JOB_SAC,  # robostrich-train's agent, these on top
+                                 batch_size=args.batch, hidden_sizes=tuple(int(h) for h in args.hidden_sizes.split(",")),
+                                 updates_per_call=args.updates_per_call, min_replay_size=0,
+                                 # the same computation as the plain implementation it is compared with
+                                 critic_layer_norm=False, her_ratio=0.0, relabel_rewards=False)
     loop = SACBuilder(config).make_components(env, seed=0)
     obs_size, act_size = loop.flattener.size, loop.actor.adapter.size
     networks = make_networks(obs_size, act_size, config.hidden_sizes)

@@ -12,10 +12,9 @@ import robostrich_suite
 from agents.replay import ObservationFlattener
 from agents.robostrich.evaluate import evaluation
 from agents.robostrich.lookup import lookup_table, LookupPolicy
-from agents.robostrich.train.main_job import FIXED_START_ARM_TASK_KWARGS
+from agents.robostrich.train.main_job import FIXED_START_ARM_TASK_KWARGS, MAIN_JOB_SAC
 from agents.robostrich.domain_run import DomainRun, make_environment, parse_plan
 from agents.sac.builder import SACBuilder
-from agents.sac.config import SACConfig
 from robostrich_suite import targets
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.studies import layout_compare
@@ -61,7 +60,7 @@ def curriculum_success(case, target_path: pathlib.Path, options, steps: int = DE
 
     per_lesson = max(steps // 3, 1)
     plan = parse_plan(",".join(f"lesson{i}:{per_lesson}" for i in (1, 2, 3)))
-    run = DomainRun(plan, SACConfig(), options.seed, str(options.out / "train" / case.label),
+    run = DomainRun(plan, MAIN_JOB_SAC, options.seed, str(options.out / "train" / case.label),
                     checkpoint_every=10 ** 9, env_factory=env_factory, name=case.label,
                     task_kwargs=FIXED_START_ARM_TASK_KWARGS)
     run.run()

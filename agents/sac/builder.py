@@ -51,7 +51,7 @@ class SACBuilder:
         """The replay, and the goal relabeler when it keeps achieved goals (HER, reward recomputation)."""
         cfg = self.config
         relabeler = GoalRelabeler.for_environment(env, flattener) if cfg.uses_goals else None
-        goal_width = relabeler.goal_size + 1 if relabeler is not None else 0  # + attitude error
+        goal_width = relabeler.reached_size if relabeler is not None else 0
         return ReplayBuffer(flattener.size, action_size, cfg.max_replay_size, seed=seed, goal_width=goal_width,
                             repeat=cfg.action_repeat)
 

@@ -1,4 +1,6 @@
-"""Hyperparameters of the SAC agent: the main job's defaults; `SACConfig.paper_sac()` gives Acme's plain SAC."""
+"""Hyperparameters of the SAC agent: `SACConfig()` is the algorithm's neutral defaults (Acme's SAC, none of
+this project's additions); a training job keeps its own tuned values (the training command's main job
+keeps the arm's)."""
 import dataclasses
 from typing import ClassVar, Optional, Tuple
 
@@ -13,10 +15,10 @@ class SACConfig:
     fingerprint, so a checkpoint is never resumed under different settings.
     """
 
-    # Defaults chosen by measurement (docs/training.md#the-main-job; a training command may generate its flags
-    # from these fields). SACConfig.paper_sac() gives the paper's / Acme's plain SAC.
-    batch_size: int = 64
-    learning_rate: float = 1e-3  # critics, actor and temperature alike
+    # Defaults: Acme's SAC (agents/jax/sac/config.py and networks.py); where Acme has no such
+    # field, the addition is off. SACConfig.paper_sac() is the paper's run of it.
+    batch_size: int = 256
+    learning_rate: float = 3e-4  # critics, actor and temperature alike
     discount: float = 0.99
     tau: float = 0.005  # Polyak rate of the target critics
     # The entropy the temperature steers the policy to: `target_entropy` if given, else
@@ -24,36 +26,33 @@ class SACConfig:
     # 9 % of each action's half-range; -2 (about 3 %) suits tasks that need their actions right to
     # about 1 % (docs/log/learning.md#the-recipe-becomes-the-default-the-main-job-over-3-seeds-2026-11-30).
     target_entropy: Optional[float] = None
-    target_entropy_per_action: float = -2.0
-    # Acme starts at 1; on rewards of a few units per step that entropy bonus outweighs the task
-    # for most of a short run, so start low and let the loss raise it.
-    init_temperature: float = 0.01
-    hidden_sizes: Tuple[int, ...] = (64, 64)
-    min_replay_size: int = 1_000
+    target_entropy_per_action: float = -1.0
+    # Acme starts at 1; on rewards of a few units per step that entropy bonus can outweigh the task
+    # for most of a short run (the main job starts at 0.01 and lets the loss raise it).
+    init_temperature: float = 1.0
+    hidden_sizes: Tuple[int, ...] = (256, 256)
+    min_replay_size: int = 10_000
     max_replay_size: int = 1_000_000
     # The learner runs `updates_per_call` gradient steps (one lax.scan) every
     # `env_steps_per_call` agent steps (transitions): update-to-data ratio = their quotient.
-    updates_per_call: int = 4
-    env_steps_per_call: int = 4
+    updates_per_call: int = 1
+    env_steps_per_call: int = 1
     # The agent acts every `action_repeat` control steps.
     action_repeat: int = 1
     reward_scale: float = 1.0
     log_std_min: float = -5.0
     log_std_max: float = 2.0
-    # Agent improvements beyond the paper's SAC (paper_sac() turns them off).
-    critic_layer_norm: bool = True  # LayerNorm in every hidden layer of both critics
+    # Agent improvements beyond the paper's SAC (off by default).
+    critic_layer_norm: bool = False  # LayerNorm in every hidden layer of both critics
     # Hindsight relabelling (HER, "future" strategy) on tasks with the goal interface (agents/goals.py;
     # other tasks get none): this fraction of every sampled batch gets a goal reached later in the
     # same episode, with the reward recomputed exactly (a curriculum may name the lessons that get
-    # it: agents/curriculum.LessonSettings).
-    her_ratio: float = 0.5
-    # Relabel only with reached poses that are goals the lesson could set (within the task's
-    # attitude tolerance where its reward asks for one; GoalRelabeler.settable).
-    her_level_goals: bool = False
+    # it: agents/curriculum.LessonSettings; the task may limit the goals to those it could set).
+    her_ratio: float = 0.0
     # Recompute every sampled transition's reward with the current lesson's reward function
     # (needs the same goal-aware tasks): after a lesson switch, lesson-1 transitions in the
     # replay then carry lesson-2 rewards instead of the ones they were collected with.
-    relabel_rewards: bool = True
+    relabel_rewards: bool = False
     # Weight of a penalty on the squared deterministic action in the actor loss (times the
     # critic's mean |Q|, as TD3+BC): keeps a residual policy (SACBuilder) at its base unless the critic
     # clearly prefers a correction (0 = off, plain SAC's actor loss; 0.4 is TD3+BC's alpha = 2.5).
@@ -63,19 +62,20 @@ class SACConfig:
     # mean sits deep in the tanh's saturation gets almost no gradient from the critic (at 2.9:
     # 1 - tanh^2 = 0.012); this pulls it back where the critic can move it
     # (docs/log/learning.md, the section of 2026-12-01 on a penalty on the pre-tanh mean).
-    pre_tanh_penalty: float = 0.1
+    pre_tanh_penalty: float = 0.0
     # Evaluate (and deploy) an exponential moving average of the policy's parameters, updated
     # with this rate after every gradient step (0 = off: the last policy, as the paper). The
     # agent still explores with its current policy, so training is unchanged bit for bit; the
     # average smooths the update-to-update wobble that moves a held-out target in or out of
     # the tolerance from one evaluation to the next: 1e-4 is about the last 10k updates
     # (docs/log/learning.md#snapshot-noise-a-longer-budget-and-a-moving-average-policy-2026-12-01).
-    policy_average: float = 1e-4
+    policy_average: float = 0.0
     # ... but early on, while 1 / policy_average is more updates than the run has made, the
     # average spans about this fraction of the updates so far (rate max(policy_average,
     # 1 / (1 + fraction * updates))) instead of keeping the initial policy's weight: a plain
     # EMA at 1e-4 leaves a short run's average mostly at the random initial policy; 0 = the
-    # plain EMA.  From 100k updates on the rate is policy_average itself.
+    # plain EMA.  From 100k updates on the rate is policy_average itself. It shapes the average
+    # only: while policy_average is 0 there is none.
     policy_average_fraction: float = 0.1
 
     # One line per field: what it sets (a training command's --help shows it beside the flag).
@@ -98,7 +98,6 @@ class SACConfig:
         "log_std_max": "upper clip of the policy's log standard deviation",
         "critic_layer_norm": "LayerNorm in every hidden layer of both critics",
         "her_ratio": "share of each batch given a hindsight goal reached later in its episode (0: off)",
-        "her_level_goals": "relabel only with reached poses the lesson could set as goals",
         "relabel_rewards": "recompute sampled rewards with the current lesson's reward function",
         "action_anchor": "weight of the actor-loss penalty that keeps a residual policy at its base (0: off)",
         "pre_tanh_penalty": "weight of the penalty on the policy's squared pre-tanh mean (0: off)",
@@ -173,25 +172,30 @@ class SACConfig:
 
     @classmethod
     def paper_sac(cls, **overrides) -> "SACConfig":
-        """Plain SAC as the paper and Acme run it: batch 256, 256x256, lr 3e-4, initial
-        temperature 1, 10k random transitions first, one decision per control step, one update
-        per transition, none of this project's additions."""
-        values = dict(batch_size=256, learning_rate=3e-4, discount=0.99, tau=0.005, target_entropy=None,
-                      target_entropy_per_action=-1.0,
-                      init_temperature=1.0, hidden_sizes=(256, 256), min_replay_size=10_000,
-                      max_replay_size=1_000_000, updates_per_call=8, env_steps_per_call=8, action_repeat=1,
-                      reward_scale=1.0, critic_layer_norm=False, her_ratio=0.0,
-                      her_level_goals=False, relabel_rewards=False, action_anchor=0.0, pre_tanh_penalty=0.0, policy_average=0.0)
-        values.update(overrides)
-        return cls(**values)
+        """Plain SAC as the paper and Acme run it: the defaults (batch 256, 256x256, lr 3e-4, initial
+        temperature 1, 10k random transitions first, one decision per control step, one update per
+        transition, none of this project's additions), the learner called every 8 transitions
+        with 8 updates (the same ratio, in fewer calls)."""
+        return cls(**{"updates_per_call": 8, "env_steps_per_call": 8, **overrides})
 
     @property
     def uses_goals(self) -> bool:
         """Whether the replay must keep achieved goals (for HER or reward recomputation)."""
         return self.her_ratio > 0.0 or self.relabel_rewards
 
+    # Fields that configs written before 2026-12-05 hold and SACConfig no longer has, with the value
+    # that means what it now does without them: her_level_goals (hindsight goals only among those
+    # the task could set) is the reaching tasks' option hindsight_level_goals now.
+    REMOVED_FIELDS: ClassVar[dict] = {"her_level_goals": False}
+
     @classmethod
     def from_dict(cls, d: dict) -> "SACConfig":
+        """The config a dict (a checkpoint's, config.json's) holds; a removed field is dropped where
+        it holds the value that now goes without saying, refused (ValueError) otherwise."""
+        changed = {k: d[k] for k in cls.REMOVED_FIELDS if k in d and d[k] != cls.REMOVED_FIELDS[k]}
+        if changed:
+            raise ValueError(f"SACConfig no longer has {changed} (REMOVED_FIELDS says where it went)")
+        d = {k: v for k, v in d.items() if k not in cls.REMOVED_FIELDS}
         fields = {f.name for f in dataclasses.fields(cls)}
         unknown = set(d) - fields
         if unknown:

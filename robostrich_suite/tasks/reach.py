@@ -69,7 +69,9 @@ class ReachConfig:
     observe_sent_actions: k > 0 adds the observation ``sent_actions``, the last k actions the agent
     sent (clipped, newest first; at an episode's start the inputs the servos hold): with an
     action latency of up to k control steps the actions still on their way to the servos are then
-    in the observation, which the arm's state alone does not show.
+    in the observation, which the arm's state alone does not show. hindsight_level_goals: an
+    agent's hindsight goals (agents/goals.py) only from reached poses whose head was level (within
+    the attitude tolerance), goals eq. 10's lessons could set (:meth:`Reach.settable_goals`).
     """
     reward: str = "lesson2"
     initial_state: str = "fixed"
@@ -88,6 +90,7 @@ class ReachConfig:
     fixed_stored_starts: float = 0.0
     perturbation: object = None
     observe_sent_actions: int = 0
+    hindsight_level_goals: bool = False
 
 
 MAX_SENT_ACTIONS = 8  # control steps of sent actions an observation may hold
@@ -131,6 +134,7 @@ class Reach(base.Task):
             self.randomizer = perturbations_lib.Perturber(perturbation)
         self.observe_sent_actions = options.whole("observe_sent_actions", config.observe_sent_actions, 0,
                                                   MAX_SENT_ACTIONS, "a whole number of control steps")
+        self.hindsight_level_goals = options.flag("hindsight_level_goals", config.hindsight_level_goals)
         self._sent_actions = None  # (observe_sent_actions, tendons), newest first, see before_step
         self._robot_ready = False  # see _begin_robot
         self.target_position = self.target_pool[0].copy()
@@ -342,29 +346,40 @@ class Reach(base.Task):
             attitude_error_deg is None or abs(attitude_error_deg) <= self.attitude_tolerance)
 
     # --- hindsight goals ------------------------------------------------------
-    # The observation keys an agent needs to put another goal into an observation
-    # (agents/goals.py): the goal, the achieved position it is compared with, and
-    # their difference.
-    GOAL_OBSERVATION = "target_position"
-    ACHIEVED_OBSERVATION = "head_position"
-    GOAL_DELTA_OBSERVATION = "to_target"
-    ATTITUDE_ERROR_OBSERVATION = "attitude_error"  # rad
+    # What an agent needs to put another goal into an observation and recompute the reward for
+    # it (agents/goals.py): the goal, the head position it is compared with (these components of
+    # it: all on the frame, (forward, up) on the quadruped) and their difference ...
+    ACHIEVED_COMPONENTS = None
 
-    def goal_attitude_tolerance(self):
-        """How far from level (deg) a reached pose may be for its position to be a goal this
-        task could set: the attitude tolerance where the reward asks for a level head, None
-        in lesson 1 (eq. 9 ignores the attitude, so every reached position is one)."""
-        return None if self.reward_name == "lesson1" else self.attitude_tolerance
+    def goal_spec(self) -> dict:
+        return {"goal": "target_position", "achieved": "head_position",
+                "achieved_components": self.ACHIEVED_COMPONENTS, "goal_delta": "to_target"}
+
+    def achieved_goal(self, observation) -> np.ndarray:
+        """... and what a control step reached: the head position compared with the goal, then
+        the attitude error (deg) eq. 10 reads, from its observation entries."""
+        head = observation["head_position"]
+        head = head if self.ACHIEVED_COMPONENTS is None else head[list(self.ACHIEVED_COMPONENTS)]
+        return np.concatenate([head, np.degrees(observation["attitude_error"])])
+
+    def settable_goals(self, reached):
+        """Which reached poses (..., 3) are goals this task could set, under the option
+        ``hindsight_level_goals``: those within the attitude tolerance where the reward asks for
+        a level head (not in lesson 1: eq. 9 ignores the attitude). None: every one."""
+        if not self.hindsight_level_goals or self.reward_name == "lesson1":
+            return None
+        return np.abs(reached[..., 2]) <= self.attitude_tolerance
 
     def has_goal_free_reward(self) -> bool:
         """Whether this task's reward holds a part no goal changes (the inputs' change charged in
         eq. 10's lessons): the replay keeps it through hindsight goals and recomputed rewards."""
         return self.reward_name != "lesson1" and bool(self.weights.action_change)
 
-    def goal_reward(self, achieved, attitude_error_deg, goal) -> np.ndarray:
-        """The reward this task gives with the head at ``achieved`` (..., 2), its attitude
-        ``attitude_error_deg`` (...) off, had the target been ``goal`` (..., 2): eqs. 9-10
-        on arrays, equal to :meth:`get_reward` for the real target (no divergence)."""
+    def goal_reward(self, reached, goal) -> np.ndarray:
+        """The reward this task gives with the head at ``reached[..., :2]``, its attitude
+        ``reached[..., 2]`` deg off (:meth:`achieved_goal`), had the target been ``goal`` (..., 2):
+        eqs. 9-10 on arrays, equal to :meth:`get_reward` for the real target (no divergence)."""
+        achieved, attitude_error_deg = reached[..., :2], reached[..., 2]
         error = np.linalg.norm(np.asarray(goal) - np.asarray(achieved), axis=-1)
         if self.reward_name == "lesson1":
             return rewards.lesson1_rewards(error, self.position_tolerance)

@@ -27,7 +27,7 @@ from agents.robostrich.domains import as_domain, domain_of, MOVING_START_TASK, T
 from agents.robostrich.lookup import LABEL, LookupPolicy
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.robostrich.recording import open_recorder
-from agents.robostrich.domain_run import DomainRun, make_environment, parse_plan
+from agents.robostrich.domain_run import DomainRun, current_fingerprint, make_environment, parse_plan
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from robostrich_suite import files, outputs, parsing, web_viewer
@@ -349,7 +349,7 @@ def checked_fingerprint(path: str) -> dict:
     """The fingerprint of a robostrich-train checkpoint, after checking that it holds
     what a run is rebuilt from: a CheckpointError naming what it lacks, before anything is built."""
     record, _ = checkpoint.read_with_digest(path)
-    fp = record["fingerprint"]
+    fp = current_fingerprint(record["fingerprint"])
     missing = ([k for k in ("plan", "config", "lessons", "seed") if k not in fp]
                + [k for k in DomainRun.STATE_FIELDS if k not in record["payload"]])
     if missing:

@@ -1,5 +1,5 @@
-"""The main job's defaults: its budget and lesson shares per domain, the per-lesson settings and
-task options it trains with, and how the command line's plan and configuration resolve over them
+"""The main job's defaults: its budget and lesson shares per domain, the agent's settings, the per-lesson
+settings and task options it trains with, and how the command line's plan and configuration resolve over them
 (robostrich-train reads them; sweeps, peers and layouts start from them)."""
 from typing import Optional
 
@@ -11,6 +11,16 @@ from agents.sac.config import SACConfig
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.model import layouts
 
+# The agent's settings robostrich-train trains with on every domain (its flags' defaults), each measured
+# on the arm (docs/training.md#the-main-job): a decision every control step, 64x64 networks at lr 1e-3
+# with layer-normalised critics, 1k random transitions first, 4 updates every 4 transitions, a low
+# initial temperature, a target entropy of -2 per action, hindsight goals (lessons: DEFAULT_LESSONS)
+# and rewards recomputed for the current lesson, the pre-tanh penalty and the policy's moving
+# average. SACConfig() is the algorithm's neutral defaults; --paper-sac gives SACConfig.paper_sac().
+MAIN_JOB_SAC = SACConfig(batch_size=64, learning_rate=1e-3, target_entropy_per_action=-2.0, init_temperature=0.01,
+                         hidden_sizes=(64, 64), min_replay_size=1_000, updates_per_call=4, env_steps_per_call=4,
+                         critic_layer_norm=True, her_ratio=0.5, relabel_rewards=True, pre_tanh_penalty=0.1,
+                         policy_average=1e-4, policy_average_fraction=0.1)
 DEFAULT_TOTAL_STEPS = 480_000  # per run, split evenly over the lessons; the two runs train side by side
 # The main job on the frame arm: lessons 1-2 keep 160k control steps each and lesson 3, where the
 # policy refines its reach from moving starts, gets the longest share (280k of 600k), training with
@@ -26,7 +36,7 @@ MAIN_JOB_LESSON_SHARES = {"robostrich": (4, 4, 7), "robostrich_a1": (16, 16, 28,
 # success fell while it trained, and with it the standing targets
 # (docs/log/quadruped.md#2026-12-03-hindsight-goals-were-off-lesson-4-after-them-the-head-speed-term).
 _NARROW_LESSON3 = {"exploration_lessons": ("lesson3",), "exploration_target_entropy_per_action": -3.0}
-MAIN_JOB_CONFIG = {"robostrich": _NARROW_LESSON3,  # LessonSettings fields
+MAIN_JOB_LESSONS = {"robostrich": _NARROW_LESSON3,  # LessonSettings fields over DEFAULT_LESSONS
                    "robostrich_a1": {**_NARROW_LESSON3, "fresh_replay_lessons": ("lesson4",)}}
 MAX_TOTAL_STEPS = 100_000_000  # per run: about three days on 2 CPU cores
 # On the arm domains the main job trains the tasks' own routing, the reconstruction of the paper's
@@ -110,15 +120,16 @@ def plan_from_args(args):
 
 
 def config_from_args(args, argv=None, cls=SACConfig):
-    """The ``cls`` (SACConfig or LessonSettings) the flags give: under --paper-sac the paper's
-    (nothing per lesson), else the main job's settings on its domain, explicit flags on top."""
+    """The ``cls`` (SACConfig or LessonSettings) the flags give (their defaults: MAIN_JOB_SAC,
+    DEFAULT_LESSONS): under --paper-sac the paper's (nothing per lesson), else the main job's
+    settings on its domain, explicit flags on top."""
     values = config_flags.parsed_values(args, cls)
     explicit = config_flags.explicit_fields(argv, cls)
     if getattr(args, "paper_sac", False):
         paper = SACConfig.paper_sac() if cls is SACConfig else LessonSettings()
         values = {k: (v if k in explicit else getattr(paper, k)) for k, v in values.items()}
     else:  # the main job's settings on its domain, under the flags given
-        values.update({k: v for k, v in MAIN_JOB_CONFIG.get(getattr(args, "domain", None), {}).items()
+        values.update({k: v for k, v in MAIN_JOB_LESSONS.get(getattr(args, "domain", None), {}).items()
                        if k not in explicit and k in values})
     try:
         return cls(**values)

@@ -8,7 +8,7 @@ from agents import checkpoint
 from agents.curriculum import read_records, run_files
 from agents.robostrich import directory_lock
 from agents.robostrich.train import transfer
-from agents.robostrich.domain_run import run_identity
+from agents.robostrich.domain_run import current_fingerprint, run_identity
 from agents.robostrich.train.checks import TrainingSetup
 from robostrich_suite import parsing
 
@@ -61,7 +61,7 @@ def _check_resumed(args, setup: TrainingSetup, label: str, init: dict) -> dict:
     """One run's checkpoint against this command line (and its records' lines); the --init-from
     a started curriculum recorded."""
     path = os.path.join(args.out, label, checkpoint.FILE_NAME)
-    stored = checkpoint.read_fingerprint(path)
+    stored = current_fingerprint(checkpoint.read_fingerprint(path))
     if label == "curriculum":  # a started run's learner is in its checkpoint: --init-from may be left out
         if init and stored.get("init_from") != init["init_digest"]:
             raise ValueError(f"{path} did not start from --init-from {args.init_from} "

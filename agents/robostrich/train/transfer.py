@@ -29,6 +29,7 @@ import numpy as np
 
 from agents import checkpoint, trees
 from agents.robostrich.domain_run import named_layout, parse_plan
+from agents.robostrich.train.main_job import MAIN_JOB_SAC
 from agents.sac.config import SACConfig
 from robostrich_suite.tasks import quadruped_tasks as qt
 
@@ -237,8 +238,9 @@ def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = Non
     if source_layout != layout:
         raise TransferError(f"--init-from: {path} was trained with tendon layout {source_layout!r}, "
                             f"this run uses {layout!r} (pass --layout {source_layout})")
-    for field in NETWORK_FIELDS:  # read from the dict: another run's config may have other fields
-        a, b = fingerprint["config"].get(field, getattr(SACConfig(), field)), getattr(config, field)
+    for field in NETWORK_FIELDS:  # read from the dict: another run's config may have other fields, and
+        # one without the field ran robostrich-train's value of then (the main job's: SACConfig's defaults until 2026-12-05)
+        a, b = fingerprint["config"].get(field, getattr(MAIN_JOB_SAC, field)), getattr(config, field)
         a = tuple(a) if isinstance(a, list) else a
         if a != b:
             raise TransferError(f"--init-from: {path} has other networks: its {field} is {a}, this run's {b}")
