@@ -1,19 +1,21 @@
 """The domain adapter (agents/robostrich/domains.py): each arm domain and tendon layout trains and is judged on its own
 targets, with its own lookup table; dm_control domains keep working; bad names are errors that name them."""
+import dataclasses
+
 import numpy as np
 import pytest
 
 from agents import checkpoint
 from agents.robostrich.domain_run import DomainRun, parse_plan
 from agents.robostrich.domains import Domain
-from agents.sac.config import SACConfig
+from agents.robostrich.train.main_job import MAIN_JOB_SAC
 from robostrich_suite import targets
 from robostrich_suite.model import layouts
 from robostrich_suite.tasks import quadruped_tasks, reach
 
 LAYOUT = "antagonist_pairs"
-TINY = SACConfig(hidden_sizes=(16, 16), batch_size=16, min_replay_size=20, updates_per_call=2,
-                 env_steps_per_call=2)
+TINY = dataclasses.replace(MAIN_JOB_SAC, hidden_sizes=(16, 16), batch_size=16, min_replay_size=20,
+                           updates_per_call=2, env_steps_per_call=2)  # the main job's agent, small
 
 
 def test_quadruped_domain_reads_the_frame_arms_targets_and_lookup_in_its_trunk_frame():

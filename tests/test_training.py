@@ -16,8 +16,9 @@ from agents.curriculum import LessonSettings, format_plan
 from agents.robostrich.domain_run import DEFAULT_LESSONS, DomainRun, parse_plan
 from agents.sac.config import SACConfig
 
-TINY = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=200, max_replay_size=5000,
-                 updates_per_call=4, env_steps_per_call=8)
+# The main job's agent (its flags' defaults), small.
+TINY = dataclasses.replace(main_job.MAIN_JOB_SAC, batch_size=32, hidden_sizes=(32, 32), min_replay_size=200,
+                           max_replay_size=5000, updates_per_call=4, env_steps_per_call=8)
 TINY_ARGS = ["--domain", "point_mass", "--hidden-sizes", "32,32", "--batch-size", "32", "--min-replay-size", "200",
              "--max-replay-size", "5000", "--updates-per-call", "4", "--env-steps-per-call", "8",
              "--num-eval-targets", "1", "--no-figures", "--no-rerun", "--quiet", "--no-baseline"]

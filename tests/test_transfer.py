@@ -14,12 +14,14 @@ from robostrich_suite.tasks import quadruped_tasks
 
 from agents import checkpoint
 from agents.robostrich.train import transfer
+from agents.robostrich.train.main_job import MAIN_JOB_SAC
 from agents.robostrich.domain_run import DomainRun, parse_plan
 from agents.sac.config import SACConfig
 from test_cli import assert_succeeded, assert_user_error, call, finish, start
 
-TINY = SACConfig(hidden_sizes=(16, 16), batch_size=16, min_replay_size=50, max_replay_size=2000,
-                 updates_per_call=2, env_steps_per_call=2)
+# The main job's agent (robostrich-train's defaults, so that its runs and these match), small.
+TINY = dataclasses.replace(MAIN_JOB_SAC, hidden_sizes=(16, 16), batch_size=16, min_replay_size=50,
+                           max_replay_size=2000, updates_per_call=2, env_steps_per_call=2)
 TINY_ARGS = ["--hidden-sizes", "16,16", "--batch-size", "16", "--min-replay-size", "50", "--max-replay-size", "2000",
              "--updates-per-call", "2", "--env-steps-per-call", "2", "--num-eval-targets", "1",
              "--final-eval-targets", "1", "--quiet", "--no-rerun", "--no-figures"]
