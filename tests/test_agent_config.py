@@ -52,7 +52,7 @@ def _rewritten(path, tmp_path, name, **config):
 
 @pytest.fixture(scope="module")
 def trained(tmp_path_factory):
-    tiny = dataclasses.replace(main_job.MAIN_JOB_SAC, hidden_sizes=(16, 16), batch_size=16, min_replay_size=20)
+    tiny = dataclasses.replace(main_job.MAIN_JOB_SAC, hidden_sizes=(16, 16), batch_size=16)  # 80 steps: no update
     plan = parse_plan("robostrich/lesson1:40,robostrich/lesson2:40")
     run = DomainRun(plan, tiny, 0, str(tmp_path_factory.mktemp("run")), checkpoint_every=10 ** 6)
     run.run()
