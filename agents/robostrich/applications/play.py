@@ -22,13 +22,6 @@ from robostrich_suite import cli as cli_lib
 LABEL = "policy"
 
 
-def _line(kind: str, summary: dict) -> str:
-    return (f"{kind:8s} {summary['success_rate'] * 100:5.1f} % reached "
-            f"({summary['precise_success_rate'] * 100:.1f} % within 1 cm and 2 deg), "
-            f"median error {summary['position_error_median'] * 100:.2f} cm, "
-            f"{summary['attitude_error_median']:.2f} deg, {summary['episodes']} targets")
-
-
 def _stabilize_line(metrics: dict) -> str:
     return (f"head_stabilize: height {metrics['height_rms_error'] * 100:.1f} cm RMS, head / trunk vertical "
             f"velocity {metrics['head_vz_rms_ratio']:.2f}, P_d {metrics['distance_mean_error'] * 100:.1f} cm off, "
@@ -41,7 +34,7 @@ def play_track(policy, domain, args) -> tuple:
     with open_recorder(None if args.no_rerun else os.path.join(args.out, written[-1]), f"{LABEL} track") as recorder:
         report = evaluation.evaluate_track(policy, policy.flatten, domain, TRACK_TASK, recorder=recorder)
     figures.plot_track({LABEL: report}, os.path.join(args.out, written[0]))
-    print(_line("track", report["summary"]), flush=True)
+    print(f"track    {evaluation.outcome_text('track', report['summary'])}", flush=True)
     return report, written
 
 
@@ -82,7 +75,7 @@ def main(argv=None) -> dict:
     print(f"{args.policy} ({domain.describe()}, seed {policy.info.get('seed')}, "
           f"{policy.info.get('env_steps')} control steps of training)", flush=True)
     reports = {"heldout": evaluation.evaluate_heldout(policy, policy.flatten, domain, heldout_task, args.num_targets)}
-    print(_line("heldout", reports["heldout"]["summary"]), flush=True)
+    print(f"heldout  {evaluation.outcome_text('heldout', reports['heldout']['summary'])}", flush=True)
     second, play = ("head_stabilize", play_stabilize) if domain.on_quadruped else ("track", play_track)
     reports[second], written = play(policy, domain, args)
     for kind, report in reports.items():

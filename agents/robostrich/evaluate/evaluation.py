@@ -286,10 +286,18 @@ def episode_count(domain, num_targets: Optional[int], track_task: Optional[str])
     return count * (1 + (len(moving_starts(domain=domain)[0]) if domain.has_moving_starts else 0)) + bool(track_task)
 
 
+def outcome_text(kind: str, s: dict) -> str:
+    """One evaluation's outcome in words: success at the task's tolerances, the share within 1 cm and
+    2 deg, the median final errors and how many targets (episodes, from moving starts)."""
+    return (f"{s['success_rate'] * 100:5.1f} % reached ({s['precise_success_rate'] * 100:.1f} % within 1 cm and "
+            f"2 deg), median error {s['position_error_median'] * 100:.2f} cm, {s['attitude_error_median']:.2f} deg, "
+            f"{s['episodes']} {'targets' if kind != 'heldout_moving' else 'episodes'}")
+
+
 def summary_lines(runs: dict) -> list:
     """What a person reads at the end of an evaluation (the JSON stays in the files): per run and
-    kind, success at the task's tolerances, the share within 1 cm and 2 deg and the median final
-    errors, as robostrich-play prints them; returns only, off the arm. ``runs``: label -> kind -> summary."""
+    kind, ``outcome_text`` (as robostrich-play prints it), or the return off the arm.
+    ``runs``: label -> kind -> summary."""
     lines = []
     for label, kinds in runs.items():
         for kind, s in kinds.items():
@@ -299,11 +307,7 @@ def summary_lines(runs: dict) -> list:
                 lines.append(f"{head} return {s['return_mean']:.1f} mean [{s['return_min']:.1f}, "
                              f"{s['return_max']:.1f}], {s['episodes']} episodes")
                 continue
-            lines.append(f"{head} {s['success_rate'] * 100:5.1f} % reached "
-                         f"({s['precise_success_rate'] * 100:.1f} % within 1 cm and 2 deg), "
-                         f"median error {s['position_error_median'] * 100:.2f} cm, "
-                         f"{s['attitude_error_median']:.2f} deg, {s['episodes']} "
-                         f"{'targets' if kind != 'heldout_moving' else 'episodes'}")
+            lines.append(f"{head} {outcome_text(kind, s)}")
     return lines
 
 
