@@ -13,7 +13,7 @@ PATH_MAX = 4096  # bytes, the terminating NUL included (Linux)
 NAME_MAX = 255  # bytes of one name
 # Room kept below PATH_MAX for what a command puts inside a directory it is given (say
 # figures/learning_curves.png, or an evaluation's LABEL_heldout_moving.json), and for the temporary
-# name a file is written under before it takes its own (robostrich_suite/files.py).
+# name a file is written under before it takes its own (robostrich_suite/atomic_files.py).
 INSIDE_ROOM = 320
 TEMPORARY_ROOM = 32
 

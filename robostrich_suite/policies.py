@@ -22,7 +22,7 @@ import zipfile
 
 import numpy as np
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite import parsing
 
@@ -108,7 +108,7 @@ class Policy:
                       action_high=self.action_high)
         meta = {"format_version": FORMAT_VERSION, "fingerprint": self.fingerprint,
                 "observation_layout": [list(item) for item in self.observation_layout], "info": self.info}
-        with files.replaced_atomically(path) as f:
+        with atomic_files.replaced_atomically(path) as f:
             np.savez_compressed(f, meta=np.array(json.dumps(meta)), **arrays)
 
 

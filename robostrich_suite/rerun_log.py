@@ -28,14 +28,14 @@ import mujoco
 import numpy as np
 import rerun as rr
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 
 SIM_TIME = "sim_time"
 
 
 class RecordingFile:
     """A recording stream encoded in memory: ``close()`` writes it to ``path`` whole (through
-    files.replaced_atomically, so a failed write names ``path`` and leaves no partial file),
+    atomic_files.replaced_atomically, so a failed write names ``path`` and leaves no partial file),
     ``discard()`` drops it (``path`` keeps what it held). Rerun's own file sink writes from a
     thread of its own and only logs a failed write; its stream read once, at the end, is the whole
     .rrd (one read per chunk would make a file of many streams, which Rerun calls corrupt). Memory:
@@ -57,7 +57,7 @@ class RecordingFile:
     def close(self) -> pathlib.Path:
         data = self.encoded.read(flush=True) or b""
         self.stream.disconnect()
-        with files.replaced_atomically(self.path) as handle:
+        with atomic_files.replaced_atomically(self.path) as handle:
             handle.write(data)
         return self.path
 

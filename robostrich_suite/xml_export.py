@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pathlib
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs
 
@@ -36,7 +36,7 @@ def export(directory: pathlib.Path) -> list[pathlib.Path]:
     written = []
     for name, generate in generators().items():
         path = directory / name
-        files.write_text(path, generate())
+        atomic_files.write_text(path, generate())
         written.append(path)
     return written
 

@@ -149,14 +149,14 @@ def test_env_benchmark_resets_its_raw_baseline_like_the_environment(capsys, tmp_
     steps from the fixed start), as does the bare dm_control environment beside them, and the tool
     prints the rates and the median of its rounds' ratios."""
     tool = load_tool("benchmark_env")
-    from robostrich_suite import benchmarking
-    assert benchmarking.episode_steps("robostrich", "lesson2") == 250
-    assert benchmarking.episode_steps("robostrich", "track") == 750
-    actions = benchmarking.random_actions("robostrich", "lesson2")
+    from robostrich_suite import speed_benchmarks
+    assert speed_benchmarks.episode_steps("robostrich", "lesson2") == 250
+    assert speed_benchmarks.episode_steps("robostrich", "track") == 750
+    actions = speed_benchmarks.random_actions("robostrich", "lesson2")
     raw = tool.RawLoop(actions, 250)
     raw.run(300)  # an episode of 250 control steps, then 50 of the next from the fixed start
     assert raw.data.time == pytest.approx(50 * 0.008)
-    wrapped = benchmarking.EnvLoop("robostrich", "lesson2", actions)
+    wrapped = speed_benchmarks.EnvLoop("robostrich", "lesson2", actions)
     wrapped.run(300)
     assert wrapped.env.physics.data.time == pytest.approx(50 * 0.008)
     np.testing.assert_array_equal(wrapped.env.physics.data.qpos, raw.data.qpos)  # the same episodes

@@ -11,11 +11,11 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "robostrich_suite"
 # Each module's layer; a module may import from its own layer and the ones below it.
 LAYERS = ("utilities", "model", "physics", "tasks", "domains", "studies")
-TOP_LEVEL = {"cli": "utilities", "rerun_log": "utilities", "rerun_blueprint": "utilities", "web_viewer": "utilities", "files": "utilities", "outputs": "utilities",
+TOP_LEVEL = {"cli": "utilities", "rerun_log": "utilities", "rerun_blueprint": "utilities", "web_viewer": "utilities", "atomic_files": "utilities", "outputs": "utilities",
              "parallel": "utilities", "progress": "utilities", "parsing": "utilities", "targets": "model", "physics": "physics", "quadruped_physics": "physics",
              "scenes": "physics", "fingerprint": "physics", "robostrich": "domains",
              "robostrich_a1": "domains", "gym_adapter": "domains", "policies": "domains",
-             "xml_export": "domains", "benchmarking": "domains", "__init__": "domains"}
+             "xml_export": "domains", "speed_benchmarks": "domains", "__init__": "domains"}
 
 
 def layer_of(module: str) -> str:

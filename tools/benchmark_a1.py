@@ -23,7 +23,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-from robostrich_suite import benchmarking, robostrich_a1  # noqa: E402
+from robostrich_suite import speed_benchmarks, robostrich_a1  # noqa: E402
 from robostrich_suite.model import quadruped  # noqa: E402
 from robostrich_suite.tasks import gait, quadruped_tasks  # noqa: E402
 
@@ -60,12 +60,12 @@ def main(argv=None):
     parser.add_argument("--task", default="lesson4", choices=list(robostrich_a1.SUITE), help="the task to step")
     parser.add_argument("--json", default=None, help="also write the rates and ratios here (a results record's input)")
     args = parser.parse_args(argv)
-    actions = benchmarking.random_actions("robostrich_a1", args.task)
+    actions = speed_benchmarks.random_actions("robostrich_a1", args.task)
     raw = raw_gait = wrapped = 0.0
     for _ in range(args.repeats):
         raw = max(raw, raw_steps_per_second(args.steps, actions))
         raw_gait = max(raw_gait, raw_steps_per_second(args.steps, actions, with_gait=True))
-        wrapped = max(wrapped, benchmarking.env_steps_per_second("robostrich_a1", args.task,
+        wrapped = max(wrapped, speed_benchmarks.env_steps_per_second("robostrich_a1", args.task,
                                                                  args.steps, actions))
     print(f"raw mj_step x4        : {raw:10.0f} control steps/s")
     print(f"raw + gait targets    : {raw_gait:10.0f} control steps/s")
@@ -74,15 +74,15 @@ def main(argv=None):
     print(f"ratio env/raw         : {wrapped / raw:10.3f}")
     print(f"ratio (raw+gait)/raw  : {raw_gait / raw:10.3f}")
     if args.json:
-        benchmarking.write_report(
+        speed_benchmarks.write_report(
             args.json, __file__, argv if argv is not None else sys.argv[1:],
             f"robostrich_a1/{args.task} against raw mj_step of the same model, the loops in turn "
             f"{args.repeats} times for {args.steps} control steps, the best rate of each kept",
-            [benchmarking.rate("raw mj_step x4", raw, "control steps/s"),
-             benchmarking.rate("raw mj_step x4 + the gait's joint targets", raw_gait, "control steps/s"),
-             benchmarking.rate(f"robostrich_a1/{args.task}", wrapped, "control steps/s")],
-            [benchmarking.ratio(f"robostrich_a1/{args.task} / raw mj_step", wrapped / raw),
-             benchmarking.ratio("raw + gait / raw mj_step", raw_gait / raw)])
+            [speed_benchmarks.rate("raw mj_step x4", raw, "control steps/s"),
+             speed_benchmarks.rate("raw mj_step x4 + the gait's joint targets", raw_gait, "control steps/s"),
+             speed_benchmarks.rate(f"robostrich_a1/{args.task}", wrapped, "control steps/s")],
+            [speed_benchmarks.ratio(f"robostrich_a1/{args.task} / raw mj_step", wrapped / raw),
+             speed_benchmarks.ratio("raw + gait / raw mj_step", raw_gait / raw)])
         print(f"wrote {args.json}")
 
 

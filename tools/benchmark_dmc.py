@@ -133,7 +133,7 @@ def format_table(rows) -> str:
 
 
 def write_atomic(path: str, text: str) -> None:
-    from robostrich_suite.files import write_text  # the project's one atomic writer
+    from robostrich_suite.atomic_files import write_text  # the project's one atomic writer
     write_text(path, text)
 
 

@@ -25,7 +25,7 @@ from dm_control import mujoco as dm_mujoco  # noqa: E402
 from dm_control.rl import control  # noqa: E402
 from dm_control.suite import base  # noqa: E402
 
-from robostrich_suite import benchmarking, robostrich  # noqa: E402
+from robostrich_suite import speed_benchmarks, robostrich  # noqa: E402
 from robostrich_suite.tasks import conventions, lessons  # noqa: E402
 
 
@@ -70,13 +70,13 @@ class BareTask(base.Task):
         return 0.0
 
 
-def bare_loop(actions: np.ndarray) -> benchmarking.EnvLoop:
+def bare_loop(actions: np.ndarray) -> speed_benchmarks.EnvLoop:
     """A plain dm_control environment of the same model with ``BareTask``: the same control
     step and episodes (2 s from the model's initial state) as the lesson's."""
     physics = dm_mujoco.Physics.from_xml_string(robostrich.get_model_and_assets()[0])
     env = control.Environment(physics, BareTask(random=0), time_limit=lessons.LESSON_TIME_LIMIT,
                               control_timestep=conventions.CONTROL_TIMESTEP)
-    return benchmarking.EnvLoop.of(env, actions)
+    return speed_benchmarks.EnvLoop.of(env, actions)
 
 
 def round_ratio(raw_seconds, seconds) -> tuple:
@@ -91,10 +91,10 @@ def main(argv=None):
     parser.add_argument("--task", default="lesson2", help="the robostrich task to step")
     parser.add_argument("--json", default=None, help="also write the rates and ratios here (a results record's input)")
     args = parser.parse_args(argv)
-    actions = benchmarking.random_actions("robostrich", args.task)
-    raw = RawLoop(actions, benchmarking.episode_steps("robostrich", args.task))
+    actions = speed_benchmarks.random_actions("robostrich", args.task)
+    raw = RawLoop(actions, speed_benchmarks.episode_steps("robostrich", args.task))
     bare = bare_loop(actions)
-    wrapped = benchmarking.EnvLoop("robostrich", args.task, actions)
+    wrapped = speed_benchmarks.EnvLoop("robostrich", args.task, actions)
     loops = {"raw": raw, "bare": bare, "env": wrapped}
     seconds = {name: [] for name in loops}
     for loop in loops.values():
@@ -111,17 +111,17 @@ def main(argv=None):
         print(f"ratio {name + '/raw':9s}: {median:10.3f} (median of {args.rounds} rounds; "
               f"quartiles {low:.3f}-{high:.3f})")
     if args.json:
-        benchmarking.write_report(
+        speed_benchmarks.write_report(
             args.json, __file__, argv if argv is not None else sys.argv[1:],
             f"robostrich/{args.task} against raw mj_step of the same model and episodes, the three loops "
             f"alternating in {args.rounds} rounds of {args.steps} control steps; each ratio the median of "
             "the rounds' ratios [quartiles], each rate the best round",
-            [benchmarking.rate(f"raw mj_step x{raw.substeps}", best["raw"], "control steps/s"),
-             benchmarking.rate("bare dm_control environment", best["bare"], "control steps/s"),
-             benchmarking.rate(f"robostrich/{args.task}", best["env"], "control steps/s")],
-            [benchmarking.ratio("bare dm_control / raw mj_step", ratios["bare"][1], ratios["bare"][0],
+            [speed_benchmarks.rate(f"raw mj_step x{raw.substeps}", best["raw"], "control steps/s"),
+             speed_benchmarks.rate("bare dm_control environment", best["bare"], "control steps/s"),
+             speed_benchmarks.rate(f"robostrich/{args.task}", best["env"], "control steps/s")],
+            [speed_benchmarks.ratio("bare dm_control / raw mj_step", ratios["bare"][1], ratios["bare"][0],
                                 ratios["bare"][2]),
-             benchmarking.ratio(f"robostrich/{args.task} / raw mj_step", ratios["env"][1], ratios["env"][0],
+             speed_benchmarks.ratio(f"robostrich/{args.task} / raw mj_step", ratios["env"][1], ratios["env"][0],
                                 ratios["env"][2])])
         print(f"wrote {args.json}")
 

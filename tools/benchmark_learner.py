@@ -215,21 +215,21 @@ def main(argv=None):
     print(f"training throughput estimate (action repeat {args.action_repeat}, {ud:g} update per transition): "
           f"{1.0 / per_step:.0f} control steps/s")
     if args.json:
-        from robostrich_suite import benchmarking
-        benchmarking.write_report(
+        from robostrich_suite import speed_benchmarks
+        speed_benchmarks.write_report(
             args.json, __file__, argv if argv is not None else sys.argv[1:],
             f"the learner's jitted update ({config.hidden_sizes} networks, batch {config.batch_size}, "
             f"{k} updates fused) and the acting loop on {args.domain}/{args.task}, each against a plain "
             "version in the same run; variants in interleaved rounds, the best round of each kept",
-            [benchmarking.rate(f"learner, one jit with lax.scan x{k}", results["ours"], "updates/s"),
-             benchmarking.rate("plain SAC update, each loss jitted", results["plain_jit_per_loss"], "updates/s"),
-             benchmarking.rate("EnvironmentLoop acting", ours_sps, "control steps/s"),
-             benchmarking.rate("raw env.step, fixed action", raw_sps, "control steps/s")],
-            [benchmarking.ratio("learner / plain SAC update, each loss jitted",
+            [speed_benchmarks.rate(f"learner, one jit with lax.scan x{k}", results["ours"], "updates/s"),
+             speed_benchmarks.rate("plain SAC update, each loss jitted", results["plain_jit_per_loss"], "updates/s"),
+             speed_benchmarks.rate("EnvironmentLoop acting", ours_sps, "control steps/s"),
+             speed_benchmarks.rate("raw env.step, fixed action", raw_sps, "control steps/s")],
+            [speed_benchmarks.ratio("learner / plain SAC update, each loss jitted",
                                 results["ours"] / results["plain_jit_per_loss"]),
-             benchmarking.ratio("learner / plain SAC update without jit", results["ours"] / results["plain_eager"]),
-             benchmarking.ratio("EnvironmentLoop / plain loop (eager policy, lists)", ours_sps / plain_sps),
-             benchmarking.ratio("EnvironmentLoop / raw env.step", ours_sps / raw_sps)])
+             speed_benchmarks.ratio("learner / plain SAC update without jit", results["ours"] / results["plain_eager"]),
+             speed_benchmarks.ratio("EnvironmentLoop / plain loop (eager policy, lists)", ours_sps / plain_sps),
+             speed_benchmarks.ratio("EnvironmentLoop / raw env.step", ours_sps / raw_sps)])
         print(f"wrote {args.json}")
 
 

@@ -115,7 +115,7 @@ def plot(head, neck, masks, pivot_point, rows, mount, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from robostrich_suite.files import save_figure
+    from robostrich_suite.atomic_files import save_figure
     fig, axes = plt.subplots(1, 4, figsize=(20, 5.5), sharex=True, sharey=True)
     rng = np.random.default_rng(0)
     for ax, (name, mask) in zip(axes, masks.items()):
@@ -187,7 +187,7 @@ def main(argv=None):
         "curled_to_raised": [{"from": r["from"], "to": r["to"],
                               "rearmost_x_in_band_m": round(r["rearmost_x_in_band"], 3)} for r in rows],
     }
-    from robostrich_suite.files import write_text
+    from robostrich_suite.atomic_files import write_text
     os.makedirs(args.out, exist_ok=True)
     write_text(os.path.join(args.out, "gap_kinematics.json"), json.dumps(summary, indent=1) + "\n")
     plot(head, neck, masks, pivot_point, rows, mount, os.path.join(args.out, "gap_kinematics.png"))

@@ -43,7 +43,7 @@ import results_peers
 import results_robustness
 import results_seeds
 import results_speed
-from robostrich_suite import files  # the project's one atomic writer
+from robostrich_suite import atomic_files  # the project's one atomic writer
 from robostrich_suite import parsing  # JSON read with a depth limit, errors naming the file
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -269,7 +269,7 @@ def main(argv=None) -> int:
                              args.group)
         record["order"] = args.order
         RECORDS.mkdir(parents=True, exist_ok=True)
-        files.write_text(RECORDS / f"{args.name}.json", json.dumps(record, indent=1) + "\n")
+        atomic_files.write_text(RECORDS / f"{args.name}.json", json.dumps(record, indent=1) + "\n")
         print(f"wrote {RECORDS / (args.name + '.json')}")
         return 0
     expected = expected_files(read_records(args.records), {path: read_page(path) for path in block_pages()})
@@ -280,7 +280,7 @@ def main(argv=None) -> int:
                   file=sys.stderr)
         return STALE if stale else 0
     for path in stale:
-        files.write_text(path, expected[path])
+        atomic_files.write_text(path, expected[path])
         print(f"wrote {path.relative_to(ROOT)}")
     return 0
 

@@ -10,7 +10,7 @@ from agents.robostrich import head_errors as probes
 from agents.robostrich.domains import as_domain, Domain
 from agents.robostrich.lookup import LookupPolicy
 from agents.sac.config import SACConfig
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 
 DEFAULT_DOMAIN = "robostrich"
 # What changes with the lesson unless a run says otherwise (robostrich-train's defaults too): hindsight
@@ -127,7 +127,7 @@ class DomainRun(curriculum.CurriculumRun):
     def save_checkpoint(self, path: Optional[str] = None):
         """CurriculumRun's, with a failed write (a full disk) naming the checkpoint."""
         path = path or self.checkpoint_path
-        with files.naming(path, only_unnamed=True):
+        with atomic_files.naming(path, only_unnamed=True):
             super().save_checkpoint(path)
 
     def extra_identity(self) -> dict:

@@ -13,7 +13,7 @@ import matplotlib.transforms as mtransforms
 import numpy as np
 
 from agents.robostrich import head_errors as probes
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 
 # A rate: always its whole range, so 0 % reads as 0 %; room above 1 for the lesson names.
 SUCCESS_LIMITS = (-0.03, 1.1)
@@ -41,7 +41,7 @@ def _smooth(x, n):
 
 
 def _save(fig, path: str) -> None:
-    files.save_figure(fig, path, dpi=110)
+    atomic_files.save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 

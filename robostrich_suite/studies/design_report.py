@@ -1,6 +1,6 @@
 """What ``robostrich-design`` writes: the front as a figure, ``design.json`` and layout files.
 
-Every file is written whole or not at all (:mod:`robostrich_suite.files`).  ``design.json``
+Every file is written whole or not at all (:mod:`robostrich_suite.atomic_files`).  ``design.json``
 (``"benchmark": "design"``) is what ``tools/results_page.py add`` records.
 """
 from __future__ import annotations
@@ -9,7 +9,7 @@ import json
 import pathlib
 import statistics
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 from robostrich_suite.model import layouts as layouts_lib
 from robostrich_suite.studies import design_objectives, design_space, design_study, gap_column
 
@@ -36,7 +36,7 @@ def write_layouts(front, out: pathlib.Path) -> dict:
     for trial in front[:design.FRONT_LAYOUTS]:
         layout = design_space.layout(trial.params)
         path = out / "layouts" / f"trial_{trial.number}.json"
-        files.write_text(path, json.dumps(layouts_lib.to_dict(layout, f"design_trial_{trial.number}"), indent=1) + "\n")
+        atomic_files.write_text(path, json.dumps(layouts_lib.to_dict(layout, f"design_trial_{trial.number}"), indent=1) + "\n")
         written[trial.number] = str(path)
     return written
 
@@ -128,7 +128,7 @@ def plot(study, front, path: pathlib.Path) -> pathlib.Path:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
-    files.save_figure(fig, path, dpi=90)
+    atomic_files.save_figure(fig, path, dpi=90)
     plt.close(fig)
     return path
 
@@ -137,7 +137,7 @@ def write(study, out: pathlib.Path, command: str, storage_url: str, confirmed: l
     front = design_study.pareto_front(study)
     layout_files = write_layouts(front, out)
     result = summary(study, command, storage_url, layout_files, confirmed)
-    files.write_text(out / "design.json", json.dumps(result, indent=1) + "\n")
+    atomic_files.write_text(out / "design.json", json.dumps(result, indent=1) + "\n")
     plot(study, front, out / "front.png")
     return result
 

@@ -286,7 +286,7 @@ def plot(rows: dict, result: dict, path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from robostrich_suite.files import save_figure
+    from robostrich_suite.atomic_files import save_figure
     need = gap_column.TASK_NEED
     fig, axes = plt.subplots(1, 3, figsize=(17, 5.6), gridspec_kw={"width_ratios": [1.2, 1, 1]})
     ax = axes[0]
@@ -339,7 +339,7 @@ def plot(rows: dict, result: dict, path) -> None:
 
 def main(argv=None) -> dict:
     from robostrich_suite import cli as cli_lib
-    from robostrich_suite.files import write_text
+    from robostrich_suite.atomic_files import write_text
     parser = argparse.ArgumentParser(prog="python -m robostrich_suite.studies.gap_bound",
                                      description=__doc__.splitlines()[0], allow_abbrev=False)
     parser.add_argument("--starts", type=cli_lib.whole_number(1, 10_000), default=STARTS,

@@ -36,7 +36,7 @@ import sys
 import time
 
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs
 from robostrich_suite import targets
@@ -263,7 +263,7 @@ def describe_samples(blue: dict) -> str:
 
 def write_csv(path: pathlib.Path, rows) -> None:
     keys = list(dict.fromkeys(key for row in rows for key in row))
-    with files.replaced_atomically(path, "w") as f:
+    with atomic_files.replaced_atomically(path, "w") as f:
         writer = csv.DictWriter(f, fieldnames=keys)
         writer.writeheader()
         writer.writerows(rows)
@@ -355,9 +355,9 @@ def report(args, cases, region, results, command: str) -> pathlib.Path:
     blue = {"level_heads": len(region.head_position), "kinematic_samples": args.kinematic_samples,
             "cells": region.num_cells, "cell_size_m": coverage_lib.CELL_SIZE,
             "random_samples": args.random_samples}
-    files.write_text(args.out / "layouts.md", describe_samples(blue) + "\n\n" + table)
+    atomic_files.write_text(args.out / "layouts.md", describe_samples(blue) + "\n\n" + table)
     write_csv(args.out / "layouts.csv", rows)
-    files.write_text(args.out / "layouts.json", json.dumps(
+    atomic_files.write_text(args.out / "layouts.json", json.dumps(
         {"benchmark": "layouts", "command": command, "blue_region": blue, "rows": rows}, indent=1) + "\n")
     from robostrich_suite.studies import layout_figure
     figure = layout_figure.plot(cases, region, results, args.out / "layouts.png")

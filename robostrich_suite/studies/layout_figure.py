@@ -6,7 +6,7 @@ import pathlib
 
 import numpy as np
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite import scenes
 from robostrich_suite.studies import coverage as coverage_lib
@@ -137,6 +137,6 @@ def plot(cases, region: coverage_lib.BlueRegion, results, path) -> pathlib.Path:
     fig.suptitle("Tendon layouts on the Table 1 links: blue region of Fig. 6 held level "
                  "(above), routing on the straightened neck (below)", fontsize=11)
     fig.tight_layout(rect=(0, 0.1 / rows, 1, 1 - 0.03 / rows))
-    files.save_figure(fig, path, dpi=110)
+    atomic_files.save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path

@@ -7,7 +7,7 @@ import pathlib
 
 import numpy as np
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 
 
 def movement_figure(movement, num_sticks: int = 12):
@@ -108,7 +108,7 @@ def plot_movement(movement, path: str | pathlib.Path, num_sticks: int = 12
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig = movement_figure(movement, num_sticks)
-    files.save_figure(fig, path, dpi=120)
+    atomic_files.save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path
 
@@ -157,6 +157,6 @@ def plot_comparison(movements: dict, path: str | pathlib.Path) -> pathlib.Path:
     import matplotlib.pyplot as plt
     path = pathlib.Path(path)
     fig = comparison_figure(movements)
-    files.save_figure(fig, path, dpi=120)
+    atomic_files.save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path

@@ -20,7 +20,7 @@ import pathlib
 
 import numpy as np
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs, parallel
 from robostrich_suite import progress as progress_lib
@@ -134,7 +134,7 @@ def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str, allow_em
     if not len(poses["head_position"]) and not allow_empty:  # a layout compared may hold none
         raise ValueError(f"no level-head pose to write to {path}: a target file holds at least one")
     path.parent.mkdir(parents=True, exist_ok=True)
-    with files.replaced_atomically(path) as handle:  # whole or not at all (Ctrl-C, a full disk)
+    with atomic_files.replaced_atomically(path) as handle:  # whole or not at all (Ctrl-C, a full disk)
         np.savez_compressed(handle, fingerprint=np.array(fingerprint),
                             **{key: np.asarray(poses[key]) for key in ("head_position", "head_attitude", "control")})
     targets.clear_cache()

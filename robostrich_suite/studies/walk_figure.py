@@ -8,7 +8,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 
 
 def walk_figure(series: dict, title: str = ""):
@@ -54,5 +54,5 @@ def plot_walk(series: dict, path, title: str = "") -> None:
     fig = walk_figure(series, title)
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    files.save_figure(fig, path, dpi=100)
+    atomic_files.save_figure(fig, path, dpi=100)
     plt.close(fig)

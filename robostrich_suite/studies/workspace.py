@@ -22,7 +22,7 @@ import time
 import mujoco
 import numpy as np
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs, parallel
 from robostrich_suite import progress as progress_lib
@@ -257,7 +257,7 @@ def save_samples(path: str | pathlib.Path, kinematic: KinematicSamples,
         arrays["actuated_level"] = actuated.level()
     if path.suffix != ".npz":  # where np.savez would have put it
         path = path.with_name(path.name + ".npz")
-    with files.replaced_atomically(path) as handle:
+    with atomic_files.replaced_atomically(path) as handle:
         np.savez_compressed(handle, base_joint_xz=base_xz, reach_radius=reach_radius(),
                             fingerprint=np.array(fingerprint_lib.model_fingerprint()), **arrays)
     return path

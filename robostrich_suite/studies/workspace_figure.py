@@ -6,7 +6,7 @@ import pathlib
 
 import numpy as np
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
 
 
@@ -56,6 +56,6 @@ def plot_workspace(kinematic, actuated, base_xz: np.ndarray, path: str | pathlib
                 handle.set_alpha(1)
     axes[0, 0].set_ylabel("z (m, up)")
     fig.tight_layout()
-    files.save_figure(fig, path, dpi=130, bbox_inches="tight")  # the legends below the axes too
+    atomic_files.save_figure(fig, path, dpi=130, bbox_inches="tight")  # the legends below the axes too
     plt.close(fig)
     return path

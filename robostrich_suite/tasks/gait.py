@@ -43,7 +43,7 @@ import pathlib
 
 import numpy as np
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 from robostrich_suite.model import quadruped as quad
 from robostrich_suite.model.legs import assemble, check_trunk_height, foot_depth, leg_fk, leg_ik
 
@@ -311,4 +311,4 @@ def write_gait_file(path, times, targets, comment: str | None = None) -> None:
     out.write(",".join(COLUMNS) + "\n")
     for t, row in zip(times, targets):
         out.write(",".join([f"{t:.6f}"] + [f"{v:.6f}" for v in row]) + "\n")
-    files.write_text(path, out.getvalue())
+    atomic_files.write_text(path, out.getvalue())

@@ -22,7 +22,7 @@ from agents.robostrich.evaluate.evaluation import write_json
 from agents.robostrich.applications.stabilization import GOALS
 from robostrich_suite import outputs, progress, web_viewer
 from robostrich_suite import cli as cli_lib
-from robostrich_suite.files import write_text
+from robostrich_suite.atomic_files import write_text
 from robostrich_suite.tasks import quadruped_tasks
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
 

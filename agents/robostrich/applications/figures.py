@@ -11,7 +11,7 @@ import matplotlib.patches as mpatches
 import matplotlib.pyplot as plt
 import numpy as np
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 from agents.robostrich.applications.narrow_gap import position_error
 
 COLORS = {"trained": "tab:blue", "reference": "tab:green", "zero": "tab:gray", "lookup": "tab:orange"}
@@ -23,7 +23,7 @@ def _color(label: str, i: int) -> str:
 
 def _save(fig, path: Optional[str]):
     if path is not None:
-        files.save_figure(fig, path, dpi=110)
+        atomic_files.save_figure(fig, path, dpi=110)
         plt.close(fig)
     return fig
 

@@ -30,7 +30,7 @@ from agents.robostrich.recording import open_recorder
 from agents.robostrich.domain_run import DomainRun, current_fingerprint, make_environment, parse_plan
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
-from robostrich_suite import files, outputs, parsing, web_viewer
+from robostrich_suite import atomic_files, outputs, parsing, web_viewer
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import progress as progress_lib
 from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, PRECISE_POSITION_TOLERANCE
@@ -337,8 +337,8 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
 
 
 def write_json(path: str, obj) -> None:
-    """``obj`` as JSON, written whole or not at all (robostrich_suite.files)."""
-    files.write_text(path, json.dumps(obj, indent=1, default=_json_default))
+    """``obj`` as JSON, written whole or not at all (robostrich_suite.atomic_files)."""
+    atomic_files.write_text(path, json.dumps(obj, indent=1, default=_json_default))
 
 
 def _json_default(o):

@@ -4,7 +4,7 @@ moving), so the policy and the baseline sit side by side on the same axes' scale
 import matplotlib
 import matplotlib.pyplot as plt
 
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 
 TITLES = {"heldout": "held-out, fixed start", "heldout_moving": "held-out, moving starts"}
 
@@ -35,5 +35,5 @@ def plot(report: dict, path) -> None:
     axes[0][-1].legend(fontsize=7, loc="lower left")
     fig.suptitle(f"{report['policy']} on {report['domain']}, {report['num_targets']} held-out targets", fontsize=10)
     fig.tight_layout()
-    files.save_figure(fig, path, dpi=110)
+    atomic_files.save_figure(fig, path, dpi=110)
     plt.close(fig)

@@ -23,7 +23,7 @@ from agents.robostrich.train import command as training
 from agents.robostrich.train import checks as training_input  # robostrich-train's own parser and checks, for every group's flags
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs, parsing
-from robostrich_suite.files import write_text
+from robostrich_suite.atomic_files import write_text
 from robostrich_suite.model import layouts as model_layouts
 
 PROG = "robostrich-sweep"

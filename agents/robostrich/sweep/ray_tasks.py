@@ -19,7 +19,7 @@ import tempfile
 import threading
 import time
 from agents.robostrich.sweep.table import TIMING_FILE
-from robostrich_suite.files import write_text
+from robostrich_suite.atomic_files import write_text
 
 INSTALL_HINT = "Ray is not installed; pip install -e '.[sweep]' (or pip install ray==2.60.0)"
 # A Unix socket path holds at most 107 bytes; Ray puts its sockets below its temporary directory

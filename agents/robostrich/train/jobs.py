@@ -17,7 +17,7 @@ from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.robostrich.domain_run import DomainRun
 from agents.sac.builder import SACBuilder
 from robostrich_suite import cli as cli_lib
-from robostrich_suite import files
+from robostrich_suite import atomic_files
 
 
 def read_jsonl(path):
@@ -122,7 +122,7 @@ def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
                 f.write(json.dumps(record) + "\n")
 
         start, start_steps = time.time(), run.loop.env_steps
-        with files.naming(run.run_dir, only_unnamed=True), cli_lib.deferred_interrupts():
+        with atomic_files.naming(run.run_dir, only_unnamed=True), cli_lib.deferred_interrupts():
             # Ctrl-C: a checkpoint between chunks, then KeyboardInterrupt; a failed write of the
             # run's records (a full disk) names where the run writes
             run.run(progress=progress, on_eval=on_eval, eval_at=job.eval_at, stop_requested=cli_lib.interrupted)

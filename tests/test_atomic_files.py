@@ -11,16 +11,16 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from robostrich_suite import files  # noqa: E402
+from robostrich_suite import atomic_files  # noqa: E402
 
 
 def test_an_error_mid_write_keeps_the_old_file_and_leaves_nothing_beside_it(tmp_path):
     path = tmp_path / "targets.npz"
-    with files.replaced_atomically(path) as handle:
+    with atomic_files.replaced_atomically(path) as handle:
         np.savez_compressed(handle, head_position=np.ones((3, 2)))
     before = path.read_bytes()
     with pytest.raises(RuntimeError, match="disk full"):
-        with files.replaced_atomically(path) as handle:
+        with atomic_files.replaced_atomically(path) as handle:
             handle.write(b"half a file")
             raise RuntimeError("disk full")
     assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["targets.npz"]
@@ -30,10 +30,10 @@ def test_an_error_mid_write_keeps_the_old_file_and_leaves_nothing_beside_it(tmp_
 def test_figures_and_text_land_whole_with_ordinary_permissions(tmp_path):
     fig, ax = plt.subplots()
     ax.plot([0, 1], [1, 0])
-    png = files.save_figure(fig, tmp_path / "sub" / "plot.png", dpi=50)
+    png = atomic_files.save_figure(fig, tmp_path / "sub" / "plot.png", dpi=50)
     plt.close(fig)
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and (png.stat().st_mode & 0o777) == 0o644
-    files.write_text(tmp_path / "table.md", "| a |\n")
+    atomic_files.write_text(tmp_path / "table.md", "| a |\n")
     assert (tmp_path / "table.md").read_text() == "| a |\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["sub", "table.md"]
 
@@ -42,7 +42,7 @@ def test_a_write_that_cannot_land_names_the_path_asked_for_not_the_temporary_fil
     directory = tmp_path / "a_directory"
     directory.mkdir()
     with pytest.raises(IsADirectoryError) as caught:
-        files.write_text(directory, "text")
+        atomic_files.write_text(directory, "text")
     assert caught.value.filename == str(directory)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_directory"]  # no partial file left
 
@@ -65,11 +65,11 @@ def test_a_name_of_up_to_255_bytes_is_written_under_a_temporary_name_that_fits(t
     """The temporary name (``.NAME.XXXXXXXX.partial``) of a long name is shortened, on a character's
     boundary, instead of failing with "File name too long"."""
     path = tmp_path / name
-    files.write_text(path, "x\n")
+    atomic_files.write_text(path, "x\n")
     assert path.read_text() == "x\n" and [p.name for p in tmp_path.iterdir()] == [name]
-    prefix = files.temporary_prefix(name)
+    prefix = atomic_files.temporary_prefix(name)
     assert len(prefix.encode()) + 8 + len(".partial") <= 255 and prefix.startswith("." + name[:10])
-    assert files.temporary_prefix("walk.rrd") == ".walk.rrd."  # short names keep the readable form
+    assert atomic_files.temporary_prefix("walk.rrd") == ".walk.rrd."  # short names keep the readable form
 
 
 def test_a_write_that_fails_names_the_file_and_leaves_nothing(tmp_path):
@@ -81,7 +81,7 @@ def test_a_write_that_fails_names_the_file_and_leaves_nothing(tmp_path):
     resource.setrlimit(resource.RLIMIT_FSIZE, (4096, hard))
     try:
         with pytest.raises(OSError) as caught:
-            with files.replaced_atomically(path) as handle:
+            with atomic_files.replaced_atomically(path) as handle:
                 handle.write(b"x" * 100_000)
     finally:
         resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
@@ -91,7 +91,7 @@ def test_a_write_that_fails_names_the_file_and_leaves_nothing(tmp_path):
 
 def test_an_error_about_another_file_inside_the_block_keeps_its_own_name(tmp_path):
     with pytest.raises(FileNotFoundError) as caught:
-        with files.replaced_atomically(tmp_path / "out.txt", "w") as handle:
+        with atomic_files.replaced_atomically(tmp_path / "out.txt", "w") as handle:
             handle.write(open(tmp_path / "missing.txt").read())
     assert caught.value.filename == str(tmp_path / "missing.txt") and list(tmp_path.iterdir()) == []
 
