@@ -139,8 +139,9 @@ class _QuadrupedTaskMixin:
         unlearn them); standing tasks always stand.
     """
 
-    # The goal (forward, up) is compared with these components of the 3-D head position
-    # (agents/goals.py); without them hindsight goals and recomputed rewards were silently off.
+    # The goal (forward, up) is compared with these components of the 3-D head position (the goal
+    # spec's achieved_components, agents/goals.py); without them hindsight goals and recomputed
+    # rewards were silently off.
     ACHIEVED_COMPONENTS = (0, 2)
 
     def __init__(self, *, legs: str = "stand", gait=None, trunk_heights=None, steer: bool = True,
