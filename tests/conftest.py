@@ -1,9 +1,10 @@
 """Shared test set-up: headless MuJoCo (MUJOCO_GL=egl unless the environment sets it), the
 checked-in models, one way to find an installed console script (``from conftest import
 console_script``), one way to run it as a user would (``start`` / ``finish``, sharing one XLA
-cache per module with the ``shared_jax_cache`` fixture) and ways to check Rerun recordings (``verify_rrd``,
+cache for the whole run, ``shared_jax_cache``) and ways to check Rerun recordings (``verify_rrd``,
 ``rrd_entities``, ``rrd_view_names``).
 The scripts of ``tools/`` import as modules (``import results_page``)."""
+import json
 import os
 import pathlib
 import shutil
@@ -71,17 +72,28 @@ def verify_rrd():
     return verify
 
 
-# The environment installed commands run in: headless, and (with ``shared_jax_cache``) one
-# persistent XLA cache per test module, so a later process reuses an earlier one's compilations.
+# The environment installed commands run in: headless, and (``shared_jax_cache``) one persistent XLA
+# cache for the whole test run, so a process reuses every earlier one's compilations.
 COMMAND_ENVIRONMENT = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+JAX_CACHE_SETTINGS = {  # a size limit turns on JAX's file lock, which both xdist workers need
+    "jax_persistent_cache_min_compile_time_secs": 0, "jax_persistent_cache_min_entry_size_bytes": 0,
+    "jax_compilation_cache_max_size": 8 << 30}
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session", autouse=True)
 def shared_jax_cache(tmp_path_factory):
-    """Commands this module starts share one persistent XLA cache (evaluate reuses train's compilations)."""
-    COMMAND_ENVIRONMENT.update(JAX_COMPILATION_CACHE_DIR=str(tmp_path_factory.mktemp("jax_cache")),
-                               JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS="0",
-                               JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES="0")
+    """One XLA cache for the test run, shared by both xdist workers, the commands they start and
+    the tests' own processes: compiling the learner's update is most of a tiny training's work."""
+    base = tmp_path_factory.getbasetemp()
+    cache = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "jax_cache"
+    cache.mkdir(exist_ok=True)
+    settings = {"jax_compilation_cache_dir": str(cache), **JAX_CACHE_SETTINGS}
+    variables = {name.upper(): str(value) for name, value in settings.items()}
+    os.environ.update(variables)
+    COMMAND_ENVIRONMENT.update(variables)
+    import jax
+    for name, value in settings.items():
+        jax.config.update(name, value)
 
 
 def start(name, *args, cwd=None) -> subprocess.Popen:
@@ -93,6 +105,37 @@ def start(name, *args, cwd=None) -> subprocess.Popen:
 def finish(process, timeout=600) -> subprocess.CompletedProcess:
     stdout, stderr = process.communicate(timeout=timeout)
     return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
+
+
+# Runs each (command, arguments) through the entry point its console script calls
+# (agents.robostrich.commands.launch), one after another in this one process.
+_IN_ONE_PROCESS = r"""
+import contextlib, io, json, sys
+from agents.robostrich.commands import launch
+results = {}
+for case, (prog, args) in json.loads(sys.stdin.read()).items():
+    sys.argv = [prog, *args]
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        try:
+            status = launch(prog)
+        except SystemExit as stop:
+            status = stop.code if isinstance(stop.code, int) else int(stop.code is not None)
+    results[case] = [status, stdout.getvalue(), stderr.getvalue()]
+sys.__stdout__.write(json.dumps(results))
+"""
+
+
+def run_in_one_process(cases: dict, cwd=None, env=None, timeout=600) -> dict:
+    """``{case: (command, [arguments])}`` -> ``{case: CompletedProcess}``, each as the installed command
+    would end (status, stdout, stderr), from one Python process: commands that stop at their flags'
+    checks then cost one start-up of JAX and MuJoCo in all, not one each."""
+    payload = {case: [name, [str(a) for a in args]] for case, (name, args) in cases.items()}
+    done = subprocess.run([sys.executable, "-c", _IN_ONE_PROCESS], input=json.dumps(payload), capture_output=True,
+                          text=True, env=env or COMMAND_ENVIRONMENT, cwd=cwd, timeout=timeout)
+    assert done.returncode == 0, done.stderr[-3000:]
+    return {case: subprocess.CompletedProcess([cases[case][0], *payload[case][1]], status, out, err)
+            for case, (status, out, err) in json.loads(done.stdout).items()}
 
 
 def rrd_entities(path) -> set:

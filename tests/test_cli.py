@@ -16,14 +16,13 @@ from agents import checkpoint
 from robostrich_suite import targets
 from robostrich_suite.model import layouts
 
-from conftest import finish, start
+from conftest import finish, run_in_one_process, start
 
 TINY_TRAIN = ["--plan", "lesson1:250", "--no-baseline", "--hidden-sizes", "16,16", "--batch-size", "16",
               "--min-replay-size", "50", "--num-eval-targets", "1", "--final-eval-targets", "1", "--quiet",
               "--no-rerun", "--no-figures"]
 
 
-pytestmark = pytest.mark.usefixtures("shared_jax_cache")
 
 
 def call(name, *args, cwd=None):
@@ -142,24 +141,22 @@ def test_user_errors_give_one_line_and_a_nonzero_status(tmp_path):
     data = (tmp_path / "whole.ckpt").read_bytes()
     (tmp_path / "truncated.ckpt").write_bytes(data[:len(data) // 2])
     (tmp_path / "empty.ckpt").write_bytes(b"")
-    cases = {  # side by side: each only parses, imports and checks
-        "resume_empty": start("robostrich-train", "--resume", "--quiet", "--out", empty),
-        "checkpoint_every_0": start("robostrich-train", "--checkpoint-every", "0", "--out", tmp_path / "ck0"),
-        "truncated": start("robostrich-evaluate", tmp_path / "truncated.ckpt", "--num-targets", "1", "--no-rerun",
-                           "--no-figures"),
-        "empty": start("robostrich-evaluate", tmp_path / "empty.ckpt", "--num-targets", "1"),
-        "ramp_negative": start("robostrich-movement", "--ramp-time", "-1", "--out", tmp_path / "mv"),
-        "layout": start("robostrich-train", "--layout", "tangled", "--quiet", "--out", tmp_path / "lay"),
-        "task": start("robostrich-train", "--plan", "lesson1:10,lesson9:10", "--quiet", "--out", tmp_path / "task"),
-        "xml_no_out": start("robostrich-export-xml"),  # no default: it would write into the installed package
-        "task_kwargs": start("robostrich-train", "--task-kwargs", '{"target_sampling": "worst"}', "--quiet",
-                             "--out", tmp_path / "tk"),
-        "lesson_names": start("robostrich-train", "--long-horizon-lessons", "lesson9", "--quiet",
-                              "--out", tmp_path / "ln"),
-        "head_speed": start("robostrich-train", "--domain", "robostrich_a1", "--task-kwargs",
-                            '{"weights": {"head_vertical_speed": 5}}', "--quiet", "--out", tmp_path / "hs"),
-    }
-    results = {case: finish(p) for case, p in cases.items()}
+    results = run_in_one_process({  # each only parses, imports and checks
+        "resume_empty": ("robostrich-train", ["--resume", "--quiet", "--out", empty]),
+        "checkpoint_every_0": ("robostrich-train", ["--checkpoint-every", "0", "--out", tmp_path / "ck0"]),
+        "truncated": ("robostrich-evaluate", [tmp_path / "truncated.ckpt", "--num-targets", "1", "--no-rerun",
+                                              "--no-figures"]),
+        "empty": ("robostrich-evaluate", [tmp_path / "empty.ckpt", "--num-targets", "1"]),
+        "ramp_negative": ("robostrich-movement", ["--ramp-time", "-1", "--out", tmp_path / "mv"]),
+        "layout": ("robostrich-train", ["--layout", "tangled", "--quiet", "--out", tmp_path / "lay"]),
+        "task": ("robostrich-train", ["--plan", "lesson1:10,lesson9:10", "--quiet", "--out", tmp_path / "task"]),
+        "xml_no_out": ("robostrich-export-xml", []),  # no default: it would write into the installed package
+        "task_kwargs": ("robostrich-train", ["--task-kwargs", '{"target_sampling": "worst"}', "--quiet",
+                                             "--out", tmp_path / "tk"]),
+        "lesson_names": ("robostrich-train", ["--long-horizon-lessons", "lesson9", "--quiet", "--out", tmp_path / "ln"]),
+        "head_speed": ("robostrich-train", ["--domain", "robostrich_a1", "--task-kwargs",
+                                            '{"weights": {"head_vertical_speed": 5}}', "--quiet", "--out", tmp_path / "hs"]),
+    })
     assert_user_error(results["resume_empty"], "--resume", "no checkpoint", str(empty))
     assert os.listdir(empty) == []  # nothing started
     assert_user_error(results["checkpoint_every_0"], "--checkpoint-every")

@@ -6,7 +6,7 @@ import re
 from agents.curriculum import LessonSettings
 from agents.robostrich.commands import COMMANDS
 from agents.sac.config import SACConfig
-from conftest import finish, start
+from conftest import run_in_one_process
 
 FLAG = re.compile(r"^  (-\w, )?(--[\w-]+)(.*)$")
 ONLY_DEFAULT = re.compile(r"^\(default: [^)]*\)$")
@@ -37,10 +37,8 @@ def test_the_help_parser_finds_flags_without_text():
 
 
 def test_every_flag_of_every_command_is_explained():
-    processes = {name: start(name, "--help") for name in COMMANDS}
     missing = {}
-    for name, process in processes.items():
-        result = finish(process, timeout=120)
+    for name, result in run_in_one_process({name: (name, ["--help"]) for name in COMMANDS}).items():
         assert result.returncode == 0, (name, result.stderr)
         assert "\n  --" in result.stdout, name
         if flags_without_help(result.stdout):

@@ -3,7 +3,8 @@ directory, Ctrl-C. The promise (README): exit 0 on success, 2 with one line
 `robostrich-X: error: ...` on bad input (no traceback), 130 on Ctrl-C with a checkpoint
 written (training) and nothing half-written (the others).
 
-Commands run as installed scripts, side by side where they are independent.
+Commands run as installed scripts, side by side where they are independent; the many that stop at
+their flags' checks run through the same entry point in one process (``run_in_one_process``).
 """
 import json
 import math
@@ -17,9 +18,8 @@ import numpy as np
 import pytest
 
 from agents import checkpoint
-from conftest import finish, start
+from conftest import finish, run_in_one_process, start
 
-pytestmark = pytest.mark.usefixtures("shared_jax_cache")
 
 TRAIN = ["--plan", "lesson1:300,lesson2:300", "--hidden-sizes", "16,16", "--batch-size", "16", "--min-replay-size", "50",
          "--num-eval-targets", "1", "--final-eval-targets", "1", "--eval-every", "600", "--track-task", "",
@@ -96,9 +96,12 @@ FLAG_CASES = {  # (command, arguments, fragments the one line must hold)
 @pytest.mark.long
 def test_bad_flags_exit_2_with_one_line_naming_the_flag(tmp_path):
     """Nonsense is refused before anything runs, with a bound named for every count and duration."""
-    processes = {case: start(name, *args, cwd=tmp_path) for case, (name, args, _) in FLAG_CASES.items()}
-    for case, process in processes.items():
-        one_line_error(finish(process), *FLAG_CASES[case][2])
+    results = run_in_one_process({case: (name, args) for case, (name, args, _) in FLAG_CASES.items()}, cwd=tmp_path)
+    for case, result in results.items():
+        one_line_error(result, *FLAG_CASES[case][2])
+    for name in ("robostrich-train", "robostrich-movement"):  # and as installed scripts, a heavy and a light one
+        case = next(case for case, (command, _, _) in FLAG_CASES.items() if command == name)
+        one_line_error(finish(start(name, *FLAG_CASES[case][1], cwd=tmp_path)), *FLAG_CASES[case][2])
     assert os.listdir(tmp_path) == []  # nothing written, not even a run directory
 
 
@@ -150,7 +153,8 @@ def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
     first.send_signal(signal.SIGINT)
     interrupted = finish(first)
     assert interrupted.returncode == 130, interrupted.stderr[-3000:]
-    assert interrupted.stderr.strip().splitlines()[-1].startswith("robostrich-train: interrupted"), interrupted.stderr
+    assert interrupted.stderr.strip().splitlines()[-1].startswith(
+        "robostrich-train: interrupted (checkpoint written at step "), interrupted.stderr
     assert "Traceback" not in interrupted.stderr, interrupted.stderr[-3000:]
     assert json.loads((out / "config.json").read_text())["seed"] == 0  # the second run touched nothing
     steps = {}
@@ -158,6 +162,8 @@ def test_one_run_owns_its_directory_and_ctrl_c_writes_a_checkpoint(tmp_path):
         record = checkpoint._read_record(str(out / label / "checkpoint.ckpt"))
         steps[label] = record["payload"]["loop"]["env_steps"]
         assert 0 < steps[label] <= 5800, steps
+        # the parent's one line says where each worker's checkpoint went (SIGTERM: tests/test_stops.py)
+        assert f"at step {steps[label]}: {out / label / 'checkpoint.ckpt'}" in interrupted.stderr.strip().splitlines()[-1]
     assert steps["curriculum"] < 5800 or steps["baseline"] < 5800  # stopped early, not at the plan's end
 
     missing = tmp_path / "missing"  # checkpoints with a valid checksum but no learner: a worker's one line

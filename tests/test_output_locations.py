@@ -14,9 +14,8 @@ import subprocess
 import pytest
 
 import conftest
-from conftest import finish, start
+from conftest import finish, run_in_one_process, start
 
-pytestmark = pytest.mark.usefixtures("shared_jax_cache")
 
 # Every command that takes --out, with what else it needs to get as far as writing; for targets and
 # train enough work that a check made after it would time the test out.
@@ -65,10 +64,10 @@ def test_an_evaluation_label_is_a_name_not_a_path(tmp_path):
     out = tmp_path / "a" / "b" / "D"
     cases = {"../../escaped": "no '/'", "sub/name": "no '/'", "..": "not '..'", "": "no '/'",
              "x" * 101: "at most 100 bytes", "lookup": "lookup baseline"}
-    processes = {label: start("robostrich-evaluate", "CK.ckpt", "--out", out, f"--label={label}", cwd=tmp_path)
-                 for label in cases}
-    for label, process in processes.items():
-        one_line_error(finish(process), "--label", cases[label])
+    results = run_in_one_process({label: ("robostrich-evaluate", ["CK.ckpt", "--out", out, f"--label={label}"])
+                                  for label in cases}, cwd=tmp_path)
+    for label, result in results.items():
+        one_line_error(result, "--label", cases[label])
     assert every_file(tmp_path) == []
 
 
@@ -91,19 +90,20 @@ def test_outputs_that_cannot_be_written_are_refused_before_any_work_and_nothing_
     regular = tmp_path / "somefile.txt"
     regular.write_text("")
     deep = "/".join(["d"] * 2100)  # 4199 bytes
-    processes = {}
+    cases, fragments = {}, {}
     for name, (args, file_name) in OUT_COMMANDS.items():
         under_file = regular / "sub" / file_name if file_name else regular / "sub"
-        processes[name, "under_file"] = (start(name, *args, "--out", under_file, cwd=tmp_path),
-                                         ["--out", "somefile.txt is a file"])
+        cases[name, "under_file"] = (name, [*args, "--out", under_file])
+        fragments[name, "under_file"] = ["--out", "somefile.txt is a file"]
     for name in ("robostrich-train", "robostrich-targets", "robostrich-walk", "robostrich-gait"):
         args, file_name = OUT_COMMANDS[name]
-        processes[name, "path_max"] = (start(name, *args, "--out", f"{deep}/{file_name or 'o'}", cwd=tmp_path),
-                                       ["--out", "bytes long"])
-        processes[name, "name_max"] = (start(name, *args, "--out", "n" * 256 + "/" + (file_name or "o"), cwd=tmp_path),
-                                       ["--out", "over the 255"])
-    for (name, case), (process, fragments) in processes.items():
-        line = one_line_error(finish(process, timeout=300), *fragments)
+        cases[name, "path_max"] = (name, [*args, "--out", f"{deep}/{file_name or 'o'}"])
+        fragments[name, "path_max"] = ["--out", "bytes long"]
+        cases[name, "name_max"] = (name, [*args, "--out", "n" * 256 + "/" + (file_name or "o")])
+        fragments[name, "name_max"] = ["--out", "over the 255"]
+    results = run_in_one_process({f"{name} {case}": command for (name, case), command in cases.items()}, cwd=tmp_path)
+    for (name, case), what in fragments.items():
+        line = one_line_error(results[f"{name} {case}"], *what)
         assert len(line) < 400, (name, case, line)  # the long path is shortened in the line
     assert every_file(tmp_path) == ["somefile.txt"]
 

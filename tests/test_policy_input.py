@@ -10,7 +10,6 @@ import pytest
 from robostrich_suite import policies
 from conftest import finish, start
 
-pytestmark = pytest.mark.usefixtures("shared_jax_cache")
 
 
 def _shipped() -> dict:

@@ -18,7 +18,6 @@ import pytest
 import conftest
 from agents import checkpoint
 
-pytestmark = pytest.mark.usefixtures("shared_jax_cache")
 
 
 class Running:
@@ -87,21 +86,20 @@ TRAIN = ["--plan", "lesson1:2900,lesson2:2900", "--hidden-sizes", "16,16", "--ba
          "--track-task", "", "--quiet", "--no-rerun", "--no-figures"]
 
 
-@pytest.mark.parametrize("stop, status, word", [(signal.SIGINT, 130, "interrupted"),
-                                                (signal.SIGTERM, 143, "terminated")], ids=["ctrl_c", "sigterm"])
-def test_training_with_two_workers_names_the_checkpoints_they_wrote(tmp_path, stop, status, word):
+def test_training_with_two_workers_names_the_checkpoints_they_wrote(tmp_path):
     """The parent's one line says where each worker's checkpoint went, as a run trained in one
-    process says where its went. Stopped once both runs are mid-training (each has an episode
-    recorded) and with 5,800 steps to go, so both always write one."""
+    process says where its went. Stopped by SIGTERM (Ctrl-C: tests/test_hostile_input.py) once both
+    runs are mid-training (each has an episode recorded) and with 5,800 steps to go, so both always
+    write one."""
     out = tmp_path / "run"
     command = Running("robostrich-train", *TRAIN, "--out", out)
     metrics = [out / label / "metrics.jsonl" for label in ("curriculum", "baseline")]
     command.wait_for(lambda: all(p.exists() and p.stat().st_size > 0 for p in metrics), "an episode of each run")
-    command.process.send_signal(stop)
+    command.process.send_signal(signal.SIGTERM)
     returncode = command.finish()
-    assert returncode == status, command.stderr[-3000:]
+    assert returncode == 143, command.stderr[-3000:]
     lines = command.stderr.strip().splitlines()
-    assert lines[-1].startswith(f"robostrich-train: {word} (checkpoint written at step "), command.stderr[-3000:]
+    assert lines[-1].startswith("robostrich-train: terminated (checkpoint written at step "), command.stderr[-3000:]
     for label in ("curriculum", "baseline"):
         path = out / label / "checkpoint.ckpt"
         steps = checkpoint._read_record(str(path))["payload"]["loop"]["env_steps"]

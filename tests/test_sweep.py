@@ -16,7 +16,7 @@ import pytest
 
 from agents.robostrich.sweep import grid as sweep_grid
 from agents.robostrich.sweep import table as sweep_table
-from conftest import COMMAND_ENVIRONMENT, console_script
+from conftest import COMMAND_ENVIRONMENT, console_script, run_in_one_process
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))
@@ -365,13 +365,15 @@ def test_bad_input_and_a_missing_ray_are_one_line_and_exit_2(command_env, tmp_pa
     processes = {
         "no ray": subprocess.Popen([sys.executable, "-c", hidden, "--out", tmp_path / "a"], stdout=subprocess.PIPE,
                                    stderr=subprocess.PIPE, text=True, env=command_env),
-        "bad flag": sweep("--out", tmp_path / "b", "--her-ratio", "x", env=command_env),
-        "per run": sweep("--out", tmp_path / "c", "--seed", "3", env=command_env),
-        "layout": sweep("--out", tmp_path / "d", "--layouts", "ventral_slips,nope", env=command_env),
-        "value": sweep("--out", tmp_path / "e", "--learning-rate", "-1", env=command_env),
-        "option": sweep("--out", tmp_path / "g", "--task-kwargs", '{"no_such_option": 1}', env=command_env),
         "address": sweep("--out", tmp_path / "f", "--address", "127.0.0.1:1", *TINY, env=command_env)}
-    results = {name: finish(p, timeout=300) for name, p in processes.items()}
+    results = run_in_one_process({  # refused at their flags' checks
+        "bad flag": ("robostrich-sweep", ["--out", tmp_path / "b", "--her-ratio", "x"]),
+        "per run": ("robostrich-sweep", ["--out", tmp_path / "c", "--seed", "3"]),
+        "layout": ("robostrich-sweep", ["--out", tmp_path / "d", "--layouts", "ventral_slips,nope"]),
+        "value": ("robostrich-sweep", ["--out", tmp_path / "e", "--learning-rate", "-1"]),
+        "option": ("robostrich-sweep", ["--out", tmp_path / "g", "--task-kwargs", '{"no_such_option": 1}'])},
+        env=command_env)
+    results.update({name: finish(p, timeout=300) for name, p in processes.items()})
     expected = {"no ray": "Ray is not installed; pip install -e '.[sweep]'",
                 "bad flag": "group default: robostrich-train: argument --her-ratio: invalid float value: 'x'",
                 "per run": "--seed is set for each run by robostrich-sweep",

@@ -7,7 +7,6 @@ import pytest
 from agents.robostrich.sweep import grid as sweep_grid
 from conftest import finish, start
 
-pytestmark = pytest.mark.usefixtures("shared_jax_cache")
 
 
 def _one_line(result, *fragments) -> str:
