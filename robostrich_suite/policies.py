@@ -30,7 +30,9 @@ FORMAT_VERSION = 1
 POLICY_DIR = pathlib.Path(__file__).parent / "data" / "policies"
 # The shipped policies by name (a domain's default robot and task family).
 SHIPPED = {"robostrich": POLICY_DIR / "robostrich_curriculum.npz",  # the arm on its frame
-           "robostrich_a1": POLICY_DIR / "robostrich_a1_curriculum.npz"}  # on the quadruped, after lesson 4
+           "robostrich_a1": POLICY_DIR / "robostrich_a1_curriculum.npz",  # on the quadruped, after lesson 4
+           # the arm on its frame, trained with a control step of latency drawn per episode
+           "robostrich_robust": POLICY_DIR / "robostrich_robust.npz"}
 
 
 class PolicyMismatch(ValueError):

@@ -211,13 +211,15 @@ def test_robostrich_train_randomizes_and_its_policy_carries_what_it_observes(tmp
 def test_the_command_writes_its_figure_json_and_a_results_record(tmp_path):
     script = console_script("robostrich-robustness")
     out = tmp_path / "out"
-    process = start(script, "robostrich", "--num-targets", "2", "--scales", "0,0.3", "--out", str(out),
-                    "--no-lookup")
+    # the policy trained with latency observes its sent actions, the nominal one and the lookup do not:
+    # each meets the same robots with its own observation
+    process = start(script, "robostrich_robust", "--compare", "robostrich", "--num-targets", "2", "--scales", "0,0.3",
+                    "--out", str(out))
     result = finish(process)
     assert result.returncode == 0, result.stderr
     report = json.loads((out / "robustness.json").read_text())
     assert (out / "robustness.png").stat().st_size > 10_000
-    assert report["labels"] == ["policy"] and report["num_targets"] == 2
+    assert report["labels"] == ["policy", "compare", "lookup"] and report["num_targets"] == 2
     assert "robustness: 100%" in result.stderr  # the progress bar
     assert set(report["results"]["policy"]) == set(perturbations.ARM_FAMILIES) | {"all"}
     for rows in report["results"]["policy"].values():
@@ -225,7 +227,7 @@ def test_the_command_writes_its_figure_json_and_a_results_record(tmp_path):
         assert rows[0] == report["results"]["policy"]["mass"][0]  # scale 0: the one nominal robot
         assert rows[1]["heldout"]["episodes"] == 2 and rows[1]["heldout_moving"]["episodes"] == 6
     record = results_page.make_record("robustness_test", str(out / "robustness.json"), "Robustness")
-    assert record["kind"] == "robustness" and record["command"].startswith("robostrich-robustness robostrich")
+    assert record["kind"] == "robustness" and record["command"].startswith("robostrich-robustness robostrich_robust")
     section = results_page.render_record(record)
     assert "| latency |" in section and "policy: family" in section and "s = 0.3" in section
 

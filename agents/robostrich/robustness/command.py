@@ -11,6 +11,7 @@ On the quadruped the held-out targets are reached standing, so gait_timing's lin
 by construction: it matters in the walking tasks (lesson4, head_stabilize), not measured here.
 """
 import argparse
+import dataclasses
 import os
 
 
@@ -200,13 +201,14 @@ def main(argv=None) -> dict:
     args.command_line = shlex.join(["robostrich-robustness"] + list(sys.argv[1:] if argv is None else argv))
     evaluated = [load_evaluated(args.policy, "policy")]
     domain = evaluated[0].domain
+    robot = dataclasses.replace(domain, sent_actions=0)  # what each policy observes may differ, not the robot
     if args.compare:
         evaluated.append(load_evaluated(args.compare, "compare"))
-        if evaluated[1].domain != domain:
+        if dataclasses.replace(evaluated[1].domain, sent_actions=0) != robot:
             raise ValueError(f"--compare {args.compare} is a policy of {evaluated[1].domain.describe()}, "
-                             f"not of {domain.describe()}")
+                             f"not of {robot.describe()}")
     if args.lookup and domain.lookup_table() is not None:
-        evaluated.append(lookup_evaluated(domain))
+        evaluated.append(lookup_evaluated(robot))
     _check_out(args.out)
     results = measure(evaluated, domain, args.scales, args.num_targets, progress=not args.no_progress)
     report = summary(args, evaluated, results, domain)
