@@ -31,6 +31,7 @@ import rerun as rr
 from robostrich_suite import atomic_files
 
 SIM_TIME = "sim_time"
+DISCARD_FLUSH_SECONDS = 5.0  # a stopped command waits at most this for Rerun's batcher
 
 
 class RecordingFile:
@@ -62,8 +63,11 @@ class RecordingFile:
         return self.path
 
     def discard(self) -> None:
+        # Everything logged is taken first, as close() does, then whatever the disconnect still
+        # pushes out: data left in the stream when it is dropped makes Rerun warn on stderr.
+        self.encoded.read(flush=True, flush_timeout_sec=DISCARD_FLUSH_SECONDS)
         self.stream.disconnect()
-        self.encoded.read(flush=False)  # taken, so that Rerun does not warn of dropped data
+        self.encoded.read(flush=False)
 
 
 @contextlib.contextmanager

@@ -12,6 +12,7 @@ TITLES = {"heldout": "held-out, fixed start", "heldout_moving": "held-out, movin
 def plot(report: dict, path) -> None:
     """robustness.png from the robustness.json ``report``."""
     labels = report["labels"]
+    names = {"policy": report.get("policy"), "compare": report.get("compare")}  # the policies' own names
     kinds = [k for k in TITLES if any(k in rows[0] for rows in report["results"][labels[0]].values())]
     matplotlib.use("Agg")  # files, never a window (at plot time: importing must not switch a notebook's backend)
     fig, axes = plt.subplots(len(kinds), len(labels), figsize=(4.2 * len(labels), 3.4 * len(kinds)),
@@ -25,7 +26,7 @@ def plot(report: dict, path) -> None:
                 ax.plot([r["scale"] for r in rows], [100 * r[kind]["success_rate"] for r in rows],
                         marker="o", markersize=3, label=family, **style)
             ax.axhline(90, color="grey", linestyle=":", linewidth=0.8)
-            ax.set_title(f"{label}: {TITLES[kind]}", fontsize=9)
+            ax.set_title(f"{names.get(label) or label}: {TITLES[kind]}", fontsize=9)
             ax.set_ylim(-3, 103)
             ax.grid(alpha=0.3)
             if row == len(kinds) - 1:
