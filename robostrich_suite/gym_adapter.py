@@ -25,10 +25,13 @@ frame from the model's ``side`` camera; it needs an offscreen OpenGL backend
 (``MUJOCO_GL=egl``, or ``osmesa`` with libOSMesa installed), which
 ``robostrich_suite`` picks itself when no display is set.
 
-``info`` (from ``reset`` and every ``step``) holds what the reaching tasks measure:
+``info`` (from ``reset`` and every ``step``) is what the reaching task measures at that step
+(``robostrich_suite.tasks.measurement.Measurement``, the reading evaluation and recordings take):
 ``is_success`` (the task's own test: the head within its position and attitude tolerances),
-``position_error`` (m), ``attitude_error`` (deg, signed: positive = head pitched down) and
-``target`` (x, z in m); plus ``divergence`` on the step where the physics diverged.
+``position_error`` (m), ``attitude_error`` (deg, signed: positive = head pitched down),
+``target`` and ``head_position`` ((x, z) in m, the task's frame), ``head_attitude`` (deg),
+``position_tolerance``, ``attitude_tolerance``, ``target_in_world`` and ``head_in_world``
+((x, y, z) in m); plus ``divergence`` on the step where the physics diverged.
 """
 from __future__ import annotations
 
@@ -37,6 +40,7 @@ import numpy as np
 from gymnasium import spaces
 
 import robostrich_suite
+from robostrich_suite.tasks import measurement
 
 
 class GymnasiumEnv(gymnasium.Env):
@@ -95,14 +99,10 @@ class GymnasiumEnv(gymnasium.Env):
         return self._flatten(timestep.observation), self._measures()
 
     def _measures(self) -> dict:
-        """What the task measures now (gymnasium's ``info``): success and the head's errors, for a
-        task with a target (every reaching task); nothing for one without."""
-        task, physics = self.dm_env.task, self.dm_env.physics
-        if not all(hasattr(task, name) for name in ("is_success", "position_error", "attitude_error")):
-            return {}
-        return {"is_success": bool(task.is_success(physics)), "position_error": float(task.position_error(physics)),
-                "attitude_error": float(task.attitude_error(physics)),
-                "target": np.array(task.target_position, np.float64)}
+        """What the task measures now (gymnasium's ``info``): its measurement, for a task with a
+        target (every reaching task); nothing for one without."""
+        measured = measurement.measure(self.dm_env)
+        return measured.as_dict() if measured.target is not None else {}
 
     def to_dm_action(self, action) -> np.ndarray:
         """The dm_env action (contractions in metres) for a gymnasium action."""

@@ -7,6 +7,7 @@ import robostrich_suite
 from agents.robostrich.recording import RolloutRecorder, log_training_curves
 from conftest import rrd_entities, rrd_view_names
 from robostrich_suite import rerun_blueprint
+from robostrich_suite.tasks.measurement import measure
 
 ROLLOUT_VIEWS = [rerun_blueprint.ARM_VIEW] + [title for title, _ in rerun_blueprint.ROLLOUT_SERIES]
 
@@ -17,7 +18,7 @@ def _record(env, path, steps=3):
         for _ in range(steps):
             action = np.zeros(env.action_spec().shape)
             timestep = env.step(action)
-            recorder.log_step(env, action, timestep, position_error=0.1, attitude_error=2.0)
+            recorder.log_step(env, action, timestep, measure(env))
 
 
 def test_a_rollout_of_the_arm_shows_every_link_and_opens_in_the_rollout_layout(tmp_path):

@@ -42,9 +42,9 @@ def build_parser():
 def measure(errors, every: int = 4, draws: int = 3, seed: int = 0) -> list:
     """One row per error size: episodes, success rate, median and 90th-percentile errors."""
     import robostrich_suite
-    from agents.robostrich import head_errors as probes
     from agents.robostrich.lookup import lookup_table, nearest
     from robostrich_suite import targets
+    from robostrich_suite.tasks.measurement import measure
     from tqdm import tqdm
 
     if every < 1 or draws < 1:
@@ -68,12 +68,12 @@ def measure(errors, every: int = 4, draws: int = 3, seed: int = 0) -> list:
                     timestep = env.reset()
                     while not timestep.last():
                         timestep = env.step(held)
-                    p, a = probes.head_errors(env)
-                    position.append(p)
-                    attitude.append(abs(a))
+                    measured = measure(env)
+                    position.append(measured.position_error)
+                    attitude.append(abs(measured.attitude_error))
                     bar.update()
             position, attitude = np.array(position), np.array(attitude)
-            tolerance, attitude_tolerance = probes.tolerances(env)
+            tolerance, attitude_tolerance = measured.position_tolerance, measured.attitude_tolerance
             rows.append({"error_fraction": fraction, "episodes": len(position),
                          "success_rate": float(np.mean((position <= tolerance) & (attitude <= attitude_tolerance))),
                          "position_error_median": float(np.median(position)),

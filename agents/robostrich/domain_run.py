@@ -6,11 +6,11 @@ from typing import Callable, Optional, Sequence
 from agents import curriculum
 from agents.curriculum import Lesson, LessonSettings
 from agents.robostrich import environment_state
-from agents.robostrich import head_errors as probes
 from agents.robostrich.domains import as_domain, Domain
 from agents.robostrich.lookup import LookupPolicy
 from agents.sac.config import SACConfig
 from robostrich_suite import atomic_files
+from robostrich_suite.tasks.measurement import measure
 
 DEFAULT_DOMAIN = "robostrich"
 # What changes with the lesson unless a run says otherwise (robostrich-train's defaults too): hindsight
@@ -101,6 +101,14 @@ def check_lesson_names(plan, config: SACConfig, lessons: LessonSettings, layout:
     curriculum.check_lesson_names(plan, config, lessons, [t for d in arm_domains for t in d.tasks()], bool(arm_domains))
 
 
+def episode_metrics(env) -> dict:
+    """What an episode's record in metrics.jsonl gets from its last state (the loop's
+    ``episode_probe``): the task's measurement's errors (the attitude's size) and success."""
+    measured = measure(env)
+    return {"position_error": measured.position_error, "attitude_error": abs(measured.attitude_error),
+            "success": measured.is_success}
+
+
 class DomainRun(curriculum.CurriculumRun):
     """A CurriculumRun whose lessons name domains of agents/robostrich/domains.py."""
 
@@ -121,7 +129,7 @@ class DomainRun(curriculum.CurriculumRun):
         self.env_factory = env_factory
         self.residual_scale = float(residual_scale)
         super().__init__(plan, config, seed, run_dir, self._make_lesson_environment, checkpoint_every, name,
-                         lessons=lessons, residual=self._residual(plan), episode_probe=probes.episode_metrics,
+                         lessons=lessons, residual=self._residual(plan), episode_probe=episode_metrics,
                          keep_lesson_checkpoints=keep_lesson_checkpoints, episode_state=environment_state)
 
     def save_checkpoint(self, path: Optional[str] = None):

@@ -12,8 +12,8 @@ import matplotlib.pyplot as plt
 import matplotlib.transforms as mtransforms
 import numpy as np
 
-from agents.robostrich import head_errors as probes
 from robostrich_suite import atomic_files
+from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG, POSITION_TOLERANCE
 
 # A rate: always its whole range, so 0 % reads as 0 %; room above 1 for the lesson names.
 SUCCESS_LIMITS = (-0.03, 1.1)
@@ -50,8 +50,8 @@ def _tolerances(summaries) -> tuple:
     for summary in summaries:
         if summary and "position_tolerance_m" in summary:
             return summary["position_tolerance_m"], summary.get("attitude_tolerance_deg",
-                                                                 probes.ATTITUDE_TOLERANCE)
-    return probes.POSITION_TOLERANCE, probes.ATTITUDE_TOLERANCE
+                                                                 LEVEL_TOLERANCE_DEG)
+    return POSITION_TOLERANCE, LEVEL_TOLERANCE_DEG
 
 
 def _lesson_names(runs: Dict[str, List[dict]], count: int) -> List[str]:
@@ -225,9 +225,9 @@ def track_figure(reports: Dict[str, dict], notes: Dict[str, str] = None):
     axes[1].axhline(position_tolerance, color="k", lw=0.8, ls=":",
                     label=f"position tolerance ({1000 * position_tolerance:.0f} mm)")
     axes[1].set_ylim(bottom=0.0)
-    axes[2].axhspan(probes.LEVEL_ATTITUDE - attitude_tolerance, probes.LEVEL_ATTITUDE + attitude_tolerance,
+    axes[2].axhspan(LEVEL_ATTITUDE_DEG - attitude_tolerance, LEVEL_ATTITUDE_DEG + attitude_tolerance,
                     color="green", alpha=0.15,
-                    label=f"level head ({probes.LEVEL_ATTITUDE:.0f} $\\pm$ {attitude_tolerance:.0f} deg)")
+                    label=f"level head ({LEVEL_ATTITUDE_DEG:.0f} $\\pm$ {attitude_tolerance:.0f} deg)")
     for ax in axes[1:]:
         for j, change in enumerate(_target_changes(any_report)):
             ax.axvline(change, color="grey", lw=0.7, ls="--", label="next target" if j == 0 else None)

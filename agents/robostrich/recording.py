@@ -1,5 +1,8 @@
 """Rerun recordings: evaluation rollouts (arm, head path, targets, tendon inputs, errors) and training curves.
 
+A rollout's head, target and errors are the task's measurement of each step
+(robostrich_suite/tasks/measurement.py), the reading the evaluation's numbers come from.
+
 The arm itself is drawn by `robostrich_suite.rerun_log` (its geoms as 3D
 shapes, body poses per step); other dm_control domains fall back to their
 body positions as a line strip (development only).
@@ -11,19 +14,9 @@ import numpy as np
 import rerun as rr
 
 
-def _to_3d(xz):
-    """The arm is planar in the sagittal x-z plane; Rerun wants 3D points (y = 0)."""
-    xz = np.asarray(xz, np.float64).reshape(-1)
-    return [float(xz[0]), 0.0, float(xz[1])] if xz.size == 2 else [float(v) for v in xz[:3]]
-
-
-def _target_in_world(env) -> list:
-    """The task's target as a world point: on ``robostrich_a1`` targets are (forward, up) in the
-    trunk frame (robostrich_suite.tasks.quadruped_tasks), on the frame arm world (x, z)."""
-    target = np.asarray(env.task.target_position, np.float64)
-    if hasattr(env.physics, "from_trunk_frame"):
-        return [float(v) for v in env.physics.from_trunk_frame(float(target[0]), float(target[1]))]
-    return _to_3d(target)
+def _point(vector) -> list:
+    """A world point as Rerun takes it (plain floats)."""
+    return [float(v) for v in vector]
 
 
 class RolloutRecorder:
@@ -49,33 +42,38 @@ class RolloutRecorder:
             rerun_log.log_geometry(self.rec, env.physics)
         rerun_log.log_body_poses(self.rec, env.physics)
 
-    def log_step(self, env, action, timestep, position_error=None, attitude_error=None):
+    def log_step(self, env, action, timestep, measured):
+        """One step: the robot's body poses from the physics; the head, the target and the errors
+        from ``measured``, the task's measurement of that step (robostrich_suite/tasks/measurement.py)."""
         physics, rec = env.physics, self.rec
         rec.set_time("sim_time", duration=float(physics.data.time))
         rec.set_time("step", sequence=self.step)
         self.step += 1
         self._log_arm(env)
-        if hasattr(physics, "head_position"):
-            head = _to_3d(physics.head_position())
+        if measured.head_in_world is not None:
+            head = _point(measured.head_in_world)
             self.head_path.append(head)
             rec.log("world/head", rr.Points3D([head], radii=0.008, colors=[[255, 200, 0]]))
-            rec.log("plots/head_attitude_deg", rr.Scalars(float(physics.head_attitude())))
-        if hasattr(env.task, "target_position"):
-            target = _target_in_world(env)
-            if hasattr(physics, "from_trunk_frame"):  # robostrich_a1: the target walks with the trunk
-                if not self.targets and hasattr(env.task, "world_targets"):  # narrow_gap's are fixed
-                    self.targets = [_to_3d(t) for t in env.task.world_targets]
-            elif not self.targets or self.targets[-1] != target:
-                self.targets.append(target)
-            rec.log("world/target", rr.Points3D([target], radii=0.012, colors=[[230, 40, 40]]))
+            rec.log("plots/head_attitude_deg", rr.Scalars(measured.head_attitude))
+        if measured.target_in_world is not None:
+            self._log_target(env, _point(measured.target_in_world))
         if action is not None:
             rec.log("plots/tendon_input", rr.Scalars(np.asarray(action, np.float64)))
-        if position_error is not None and np.isfinite(position_error):
-            rec.log("plots/position_error_m", rr.Scalars(float(position_error)))
-        if attitude_error is not None and np.isfinite(attitude_error):
-            rec.log("plots/attitude_error_deg", rr.Scalars(float(attitude_error)))
+        if np.isfinite(measured.position_error):
+            rec.log("plots/position_error_m", rr.Scalars(measured.position_error))
+        if np.isfinite(measured.attitude_error):
+            rec.log("plots/attitude_error_deg", rr.Scalars(abs(measured.attitude_error)))
         if timestep.reward is not None:
             rec.log("plots/reward", rr.Scalars(float(timestep.reward)))
+
+    def _log_target(self, env, target: list) -> None:
+        """This step's target, and the list of targets the recording shows at its end."""
+        if hasattr(env.physics, "from_trunk_frame"):  # robostrich_a1: the target walks with the trunk
+            if not self.targets and hasattr(env.task, "world_targets"):  # narrow_gap's are fixed
+                self.targets = [_point([x, 0.0, z]) for x, z in env.task.world_targets]
+        elif not self.targets or self.targets[-1] != target:
+            self.targets.append(target)
+        self.rec.log("world/target", rr.Points3D([target], radii=0.012, colors=[[230, 40, 40]]))
 
     def close(self):
         if len(self.head_path) > 1:

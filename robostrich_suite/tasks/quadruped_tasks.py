@@ -272,6 +272,10 @@ class _QuadrupedTaskMixin:
     def head_xz(self, physics) -> np.ndarray:
         return physics.to_trunk_frame(physics.head_position())[[0, 2]]
 
+    def target_in_world(self, physics) -> np.ndarray:
+        """The target (forward, up) in the trunk frame as a world point in the trunk's vertical plane."""
+        return physics.from_trunk_frame(float(self.target_position[0]), float(self.target_position[1]))
+
     def get_observation(self, physics):
         """Table 2 (head, joints, trunk), then the goal and tendon state (module doc)."""
         shared = super().get_observation(physics)

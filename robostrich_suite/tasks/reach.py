@@ -28,6 +28,7 @@ from robostrich_suite.tasks import options
 from robostrich_suite.tasks import perturbations as perturbations_lib
 from robostrich_suite.tasks import randomization as randomization_lib
 from robostrich_suite.tasks import rewards
+from robostrich_suite.tasks.measurement import Measurement
 from robostrich_suite.tasks.actions import check_action
 from robostrich_suite.tasks.starts import RELEASE_TIME, StartDistribution, check_initial_state
 from robostrich_suite.tasks.target_samplers import MAX_TARGET_DISTANCE, TargetSampler, as_targets
@@ -338,6 +339,26 @@ class Reach(base.Task):
 
     def is_success(self, physics) -> bool:
         return self._within_tolerances(self.position_error(physics), self.attitude_error(physics))
+
+    def measure(self, physics) -> Measurement:
+        """Everything this task measures now, read once (tasks/measurement.py): the errors and
+        success by the same functions as ``get_reward``, ``is_success`` and the observation."""
+        head = self.head_xz(physics)
+        position_error = _length(self.target_position - head)
+        attitude = physics.head_attitude()
+        attitude_error = float(physics_lib.attitude_error_deg(attitude, self.desired_attitude))
+        return Measurement(position_error, attitude_error,
+                           is_success=bool(self._within_tolerances(position_error, attitude_error)),
+                           position_tolerance=float(self.position_tolerance),
+                           attitude_tolerance=float(self.attitude_tolerance),
+                           target=self.target_position, head_position=head, head_attitude=float(attitude),
+                           target_in_world=self.target_in_world(physics), head_in_world=physics.head_position())
+
+    def target_in_world(self, physics) -> np.ndarray:
+        """The target as a world point (x, y, z): its two components on ``target_axes``, 0 on the third."""
+        point = np.zeros(3)
+        point[list(self.target_axes)] = self.target_position
+        return point
 
     def _within_tolerances(self, position_error: float, attitude_error_deg: float | None = None) -> bool:
         """Within the position tolerance and, where an attitude error is given, the attitude one:

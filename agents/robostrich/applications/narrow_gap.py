@@ -78,13 +78,14 @@ class ContactProbe:
 
 
 def recorder_for(env):
-    """`record(env, action)` for `narrow_gap`, with the contact probe of `env`'s model."""
+    """`record(env, action, measured)` for `narrow_gap`, with the contact probe of `env`'s model;
+    the head from the task's measurement `measured`."""
     probe = ContactProbe(env.physics)
 
-    def record(env, action) -> dict:
+    def record(env, action, measured) -> dict:
         physics, task = env.physics, env.task
-        head = physics.head_position()
-        head_xz = task.head_xz(physics)
+        head = measured.head_in_world
+        head_xz = measured.head_position
         arm_force, head_force = probe.forces(physics)
         return {
             "time": task.episode_time(physics), "target_index": int(task.target_index),
@@ -92,7 +93,7 @@ def recorder_for(env):
             # distance to every sub-target in the trunk frame, as the task measures it
             "target_errors": [float(np.linalg.norm(physics.to_trunk_frame([x, 0.0, z])[[0, 2]] - head_xz))
                               for x, z in task.world_targets],
-            "attitude": physics.head_attitude(), "attitude_error": abs(task.attitude_error(physics)),
+            "attitude": measured.head_attitude, "attitude_error": abs(measured.attitude_error),
             "arm_contact_force": arm_force, "head_contact_force": head_force,
             "walking": bool(task.walking()),
         }

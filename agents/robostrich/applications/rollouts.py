@@ -21,7 +21,6 @@ from typing import Callable, Optional
 import numpy as np
 
 from agents.replay import ObservationFlattener
-from agents.robostrich import head_errors as probes
 from agents.robostrich.domains import as_domain, Domain
 from agents.robostrich.evaluate.evaluation import load_run_from_checkpoint
 from agents.robostrich.lookup import LABEL, LookupPolicy
@@ -29,6 +28,7 @@ from agents.robostrich.recording import open_recorder
 from agents.sac.builder import SACBuilder
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.tasks import gait as gait_lib
+from robostrich_suite.tasks.measurement import measure
 
 DOMAIN = "robostrich_a1"
 RECORD_EVERY = 5  # control steps per recorded frame (module doc)
@@ -129,15 +129,16 @@ def make_environment(domain: Domain, task: str, seed: int, seeds: int, gait, **t
 
 
 def rollout(env, policy: Policy, record: Callable, recorder=None) -> dict:
-    """One episode of `policy`; `record(env, action)` returns a dict of numbers per control step.
-    `recorder` (a RolloutRecorder) gets every `RECORD_EVERY`-th step.
+    """One episode of `policy`; `record(env, action, measured)` returns a dict of numbers per control
+    step, given the task's measurement of that step (robostrich_suite/tasks/measurement.py), which
+    `recorder` (a RolloutRecorder) gets too every `RECORD_EVERY`-th step.
 
     Returns the columns as arrays, plus `fell` (the episode ended before its time limit: the
     quadruped fell or the physics diverged)."""
     actor, flattener = policy.bind(env)
     timestep = env.reset()
     if recorder is not None:
-        recorder.log_step(env, None, timestep)
+        recorder.log_step(env, None, timestep, measure(env))
     rows, step, action = [], 0, None
     while not timestep.last():
         cli_lib.raise_if_interrupted()  # a Ctrl-C some library swallowed
@@ -145,9 +146,10 @@ def rollout(env, policy: Policy, record: Callable, recorder=None) -> dict:
             action = np.asarray(actor.select_action(flattener(timestep.observation)), np.float64)
         timestep = env.step(action)
         step += 1
-        rows.append(record(env, action))
+        measured = measure(env)
+        rows.append(record(env, action, measured))
         if recorder is not None and (step % RECORD_EVERY == 0 or timestep.last()):
-            recorder.log_step(env, action, timestep, *probes.head_errors(env))
+            recorder.log_step(env, action, timestep, measured)
     series = {key: np.array([row[key] for row in rows]) for key in rows[0]} if rows else {}
     series["fell"] = bool(timestep.discount == 0)
     return series

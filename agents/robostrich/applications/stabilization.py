@@ -29,17 +29,18 @@ GOALS = {
 }
 
 
-def record(env, action) -> dict:
-    """One control step of `head_stabilize` (module doc)."""
+def record(env, action, measured) -> dict:
+    """One control step of `head_stabilize` (module doc); the head and its target from the task's
+    measurement `measured`."""
     physics, task = env.physics, env.task
     return {
         "time": task.episode_time(physics),
-        "head_z": float(physics.head_position()[2]), "trunk_z": physics.trunk_height(),
+        "head_z": float(measured.head_in_world[2]), "trunk_z": physics.trunk_height(),
         "head_vz": float(physics.head_velocity()[2]), "trunk_vz": float(physics.trunk_velocity()[2]),
-        "distance": float(task.head_xz(physics)[0]),
-        "desired_distance": float(task.target_position[0]), "desired_height": float(task.target_position[1]),
-        "attitude": physics.head_attitude(), "desired_attitude": task.desired_attitude,
-        "attitude_tolerance": task.attitude_tolerance, "trunk_height_command": task.trunk_height_command(physics),
+        "distance": float(measured.head_position[0]),
+        "desired_distance": float(measured.target[0]), "desired_height": float(measured.target[1]),
+        "attitude": measured.head_attitude, "desired_attitude": task.desired_attitude,
+        "attitude_tolerance": measured.attitude_tolerance, "trunk_height_command": task.trunk_height_command(physics),
     }
 
 

@@ -22,7 +22,6 @@ from agents import checkpoint
 from agents.curriculum import LessonSettings
 from agents.replay import ObservationFlattener
 from agents.robostrich import figures
-from agents.robostrich import head_errors as probes
 from agents.robostrich.domains import as_domain, domain_of, MOVING_START_TASK, TRACK_TASK
 from agents.robostrich.lookup import LABEL, LookupPolicy
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
@@ -34,6 +33,7 @@ from robostrich_suite import atomic_files, outputs, parsing, web_viewer
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import progress as progress_lib
 from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, PRECISE_POSITION_TOLERANCE
+from robostrich_suite.tasks.measurement import measure
 
 MAX_TARGETS = 10_000  # held-out targets (or seeded episodes off the arm) of one evaluation
 target_count = cli_lib.whole_number(1, MAX_TARGETS)  # argparse type of the target counts
@@ -53,15 +53,18 @@ def evaluation_label(text: str) -> str:
 
 
 def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dict:
-    """One episode with `actor` (acting every `action_repeat` control steps); per-control-step series."""
+    """One episode with `actor` (acting every `action_repeat` control steps); per-control-step series
+    of the task's measurement (robostrich_suite/tasks/measurement.py), read once per step."""
     timestep = env.reset()
     physics = env.physics
-    has_head = probes.head_xz(env) is not None
+    measured = measure(env)
+    has_head = measured.head_position is not None
     series = {k: [] for k in ("time", "position_error", "attitude_error", "head_position", "head_attitude",
                               "target", "action", "reward")}
-    series["tolerances"] = list(probes.tolerances(env))  # the task's own, not the paper's constants
+    # the task's own tolerances, not the paper's constants
+    series["tolerances"] = [measured.position_tolerance, measured.attitude_tolerance]
     if recorder is not None:
-        recorder.log_step(env, None, timestep)
+        recorder.log_step(env, None, timestep, measured)
     step = 0
     while not timestep.last():
         cli_lib.raise_if_interrupted()  # a Ctrl-C some library swallowed
@@ -69,18 +72,18 @@ def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dic
             action = actor.select_action(flattener(timestep.observation))
         timestep = env.step(action)
         step += 1
-        position_error, attitude_error = probes.head_errors(env)
+        measured = measure(env)
         series["time"].append(float(physics.data.time))
-        series["position_error"].append(position_error)
-        series["attitude_error"].append(attitude_error)
+        series["position_error"].append(measured.position_error)
+        series["attitude_error"].append(abs(measured.attitude_error))
         series["reward"].append(float(timestep.reward))
         series["action"].append(np.asarray(action, np.float64).tolist())
         if has_head:
-            series["head_position"].append(probes.head_xz(env).tolist())
-            series["head_attitude"].append(float(physics.head_attitude()))
-            series["target"].append(np.asarray(env.task.target_position, np.float64).tolist())
+            series["head_position"].append(measured.head_position.tolist())
+            series["head_attitude"].append(measured.head_attitude)
+            series["target"].append(measured.target.tolist())
         if recorder is not None:
-            recorder.log_step(env, action, timestep, position_error, attitude_error)
+            recorder.log_step(env, action, timestep, measured)
     return series
 
 
@@ -96,7 +99,7 @@ def _episode_summary(series, start=0, end=None) -> dict:
     return {
         "final_position_error": float(pe[-1]), "final_attitude_error": float(ae[-1]),
         "min_position_error": float(pe.min()),
-        "success": probes.is_success(pe[-1], ae[-1], position_tolerance, attitude_tolerance),
+        "success": bool(within[-1]),  # the task's success rule on the last step
         "tolerances": [float(position_tolerance), float(attitude_tolerance)],
         "steps_to_reach": int(reached[0] + 1) if reached.size else None,
         "steps": int(pe.size), "return": episode_return,
@@ -224,12 +227,12 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
             timestep = env.reset()
             while not timestep.last():
                 timestep = env.step(control)
-            start_error = probes.head_errors(env)
+            held = measure(env)  # where the arm came to rest
             env.task.set_initial_state("continue")
             env.task.set_target_pool(target)
             row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat))
             row.update(target=np.asarray(target).tolist(), start=k, start_target=np.asarray(start).tolist(),
-                       start_position_error=start_error[0], start_attitude_error=start_error[1])
+                       start_position_error=held.position_error, start_attitude_error=abs(held.attitude_error))
             episodes.append(row)
             if on_episode:
                 on_episode()
