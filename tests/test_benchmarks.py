@@ -193,3 +193,18 @@ def test_learner_benchmark_reports_its_ratios_against_plain_versions(tmp_path, t
                            "EnvironmentLoop / plain loop (eager policy, lists)", "EnvironmentLoop / raw env.step"}
     assert all(math.isfinite(value) and value > 0 for value in ratios.values())
     assert record["command"].startswith("python tools/benchmark_learner.py --hidden-sizes 16,16")
+
+
+def test_precision_ceiling_holds_a_stored_pose_precisely_and_counts_the_share(tmp_path):
+    """A held-out target whose stored inputs hold the head on it and level within 1 cm and 2 deg
+    counts as reachable; the share is over the targets tried; bad input is one line, exit 2."""
+    tool = load_tool("precision_ceiling")
+    result = tool.main(["--every", "42", "--seek-times", "0.5", "--out", str(tmp_path / "c")])
+    assert result["targets"] == 2 and result == json.load(open(tmp_path / "c" / "ceiling.json"))
+    first = result["rows"][0]
+    assert first["precise"] and first["seek_time"] == 0.0  # the stored inputs alone
+    assert first["position_error"] < 0.01 and first["attitude_error"] < 2.0
+    assert result["precise_share"] == sum(r["precise"] for r in result["rows"]) / 2
+    bad = subprocess.run([sys.executable, os.path.join(TOOLS, "precision_ceiling.py"), "--seek-times", "-1"],
+                         capture_output=True, text=True, cwd=tmp_path)
+    assert bad.returncode == 2 and "--seek-times" in bad.stderr.strip().splitlines()[-1]
