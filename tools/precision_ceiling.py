@@ -64,8 +64,12 @@ def build_parser():
 
 
 def main(argv=None) -> dict:
-    args = build_parser().parse_args(argv)
-    path = layouts.target_file(args.layout)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        path = layouts.target_file(args.layout)
+    except FileNotFoundError as error:  # a built-in layout whose target file does not ship
+        parser.error(str(error))
     poses, heldout = targets.level_head_poses(path), targets.heldout_targets(path)[::args.every]
     physics = scenes.frame_physics(arm_lib.ArmSpec.from_table1(), layouts.build(args.layout))
     rows = []
