@@ -8,7 +8,8 @@ generator asked for. Here every held-out target of the layout's shipped target f
 its stored inputs held from the fixed start for one episode, then with inputs sought towards a level head
 at the target from those inputs (robostrich_suite.studies.pose_seek) for each of `--seek-times` seconds;
 the best try counts. The share of targets some try holds precisely (at the episode's end, as the
-evaluation judges) is a lower bound of what any policy could reach there. Writes OUT/ceiling.json.
+evaluation judges) is a lower bound of the best share a policy could reach there: other inputs may
+hold more. Writes OUT/ceiling.json.
 """
 import argparse
 import json
@@ -16,6 +17,7 @@ import os
 
 import numpy as np
 
+from robostrich_suite import atomic_files
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import progress as progress_lib
 from robostrich_suite import physics as physics_lib
@@ -84,8 +86,7 @@ def main(argv=None) -> dict:
                                                                    conventions.PRECISE_ATTITUDE_TOLERANCE_DEG],
               "rows": rows}
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "ceiling.json"), "w") as f:
-        json.dump(result, f, indent=1)
+    atomic_files.write_text(os.path.join(args.out, "ceiling.json"), json.dumps(result, indent=1))
     print(f"{args.layout}: {precise} of {len(rows)} held-out targets held within "
           f"{conventions.PRECISE_POSITION_TOLERANCE * 100:g} cm and {conventions.PRECISE_ATTITUDE_TOLERANCE_DEG:g} deg "
           f"({100 * precise / len(rows):.1f} %); wrote {args.out}/ceiling.json")
