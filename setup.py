@@ -1,4 +1,4 @@
-"""Installs robostrich_suite (simulation) and agents (JAX SAC learner).
+"""Installs robostrich_suite (simulation), agents (JAX SAC learner) and the console commands' launcher.
 
 Versions are pinned to a set that works together: mujoco 4.0 breaks
 dm-control 1.0.50, and dm-haiku 0.0.17 is the last haiku release, tested
@@ -14,6 +14,8 @@ setup(
     classifiers=["License :: OSI Approved :: Apache Software License"],
     python_requires=">=3.11",  # numpy 2.4, jax 0.10, scipy, matplotlib 3.11 and rerun-sdk 0.41 need 3.11
     packages=find_packages(include=["robostrich_suite", "robostrich_suite.*", "agents", "agents.*"]),
+    # robostrich_commands.py: the console scripts' light launcher, beside the packages (its docstring says why)
+    py_modules=["robostrich_commands"],
     package_data={"robostrich_suite": ["data/*", "data/policies/*"]},
     install_requires=[
         "mujoco==3.17.0",
@@ -53,21 +55,21 @@ setup(
     },
     entry_points={
         "console_scripts": [
-            "robostrich-train = agents.robostrich.commands:train",
-            "robostrich-evaluate = agents.robostrich.commands:evaluate",
-            "robostrich-layouts = agents.robostrich.commands:layouts",
-            "robostrich-stabilize = agents.robostrich.commands:stabilize",
-            "robostrich-gap = agents.robostrich.commands:gap",
-            "robostrich-play = agents.robostrich.commands:play",
-            "robostrich-walk = agents.robostrich.commands:walk",
-            "robostrich-export-xml = agents.robostrich.commands:export_xml",
-            "robostrich-movement = agents.robostrich.commands:movement",
-            "robostrich-workspace = agents.robostrich.commands:workspace",
-            "robostrich-targets = agents.robostrich.commands:targets",
-            "robostrich-gait = agents.robostrich.commands:gait",
-            "robostrich-sweep = agents.robostrich.commands:sweep",
-            "robostrich-design = agents.robostrich.commands:design",
-            "robostrich-robustness = agents.robostrich.commands:robustness",
+            "robostrich-train = robostrich_commands:train",
+            "robostrich-evaluate = robostrich_commands:evaluate",
+            "robostrich-layouts = robostrich_commands:layouts",
+            "robostrich-stabilize = robostrich_commands:stabilize",
+            "robostrich-gap = robostrich_commands:gap",
+            "robostrich-play = robostrich_commands:play",
+            "robostrich-walk = robostrich_commands:walk",
+            "robostrich-export-xml = robostrich_commands:export_xml",
+            "robostrich-movement = robostrich_commands:movement",
+            "robostrich-workspace = robostrich_commands:workspace",
+            "robostrich-targets = robostrich_commands:targets",
+            "robostrich-gait = robostrich_commands:gait",
+            "robostrich-sweep = robostrich_commands:sweep",
+            "robostrich-design = robostrich_commands:design",
+            "robostrich-robustness = robostrich_commands:robustness",
         ],
     },
 )

@@ -108,10 +108,10 @@ def finish(process, timeout=600) -> subprocess.CompletedProcess:
 
 
 # Runs each (command, arguments) through the entry point its console script calls
-# (agents.robostrich.commands.launch), one after another in this one process.
+# (robostrich_commands.launch), one after another in this one process.
 _IN_ONE_PROCESS = r"""
 import contextlib, io, json, sys
-from agents.robostrich.commands import launch
+from robostrich_commands import launch
 results = {}
 for case, (prog, args) in json.loads(sys.stdin.read()).items():
     sys.argv = [prog, *args]

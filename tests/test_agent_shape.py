@@ -9,6 +9,9 @@ GENERIC = sorted(p for p in (ROOT / "agents").rglob("*.py") if "robostrich" not 
 # Words of the robot and its simulator that a generic agent has no business knowing.
 ROBOT_WORDS = re.compile(r"robostrich|mujoco|dm_control|tendon|trunk|geom|quadruped|lookup", re.IGNORECASE)
 MAX_FUNCTION_LINES = 60
+# Both packages and the console scripts' launcher beside them.
+PROJECT_MODULES = sorted([*(ROOT / "agents").rglob("*.py"), *(ROOT / "robostrich_suite").rglob("*.py"),
+                          ROOT / "robostrich_commands.py"])
 
 
 def test_generic_agent_modules_name_no_robot_and_import_no_simulator():
@@ -20,7 +23,7 @@ def test_generic_agent_modules_name_no_robot_and_import_no_simulator():
 
 def test_no_function_is_longer_than_a_screen():
     long = []
-    for path in list((ROOT / "agents").rglob("*.py")) + list((ROOT / "robostrich_suite").rglob("*.py")):
+    for path in PROJECT_MODULES:
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 lines = node.end_lineno - node.lineno + 1
@@ -32,7 +35,7 @@ def test_no_function_is_longer_than_a_screen():
 def test_no_legacy_shims_remain():
     """Older checkpoints are refused by their format version, not translated: no code for them."""
     hits = []
-    for path in list((ROOT / "agents").rglob("*.py")) + list((ROOT / "robostrich_suite").rglob("*.py")):
+    for path in PROJECT_MODULES:
         for n, line in enumerate(path.read_text().splitlines(), 1):
             # dm_control's own `legacy_step` attribute is its API, not ours
             if "legacy" in line.lower() and "legacy_step" not in line and "legacy step" not in line:

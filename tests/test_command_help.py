@@ -4,8 +4,8 @@ import dataclasses
 import re
 
 from agents.curriculum import LessonSettings
-from agents.robostrich.commands import COMMANDS
 from agents.sac.config import SACConfig
+from robostrich_commands import COMMANDS
 from conftest import run_in_one_process
 
 FLAG = re.compile(r"^  (-\w, )?(--[\w-]+)(.*)$")
@@ -55,7 +55,7 @@ def test_every_agent_setting_has_its_one_line_help():
 
 SHOW_DEFAULTS = r'''
 import argparse, importlib, json
-from agents.robostrich.commands import COMMANDS
+from robostrich_commands import COMMANDS
 
 class Caught(BaseException):
     def __init__(self, parser):

@@ -5,7 +5,8 @@ import re
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "agents").glob("*.md")), *sorted((ROOT / "docs").rglob("*.md"))]
-SOURCES = sorted(p for d in ("agents", "robostrich_suite", "tools", "tests") for p in (ROOT / d).rglob("*.py"))
+SOURCES = sorted([*(p for d in ("agents", "robostrich_suite", "tools", "tests") for p in (ROOT / d).rglob("*.py")),
+                  ROOT / "robostrich_commands.py"])
 
 
 def anchor(heading: str) -> str:

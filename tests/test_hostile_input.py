@@ -252,7 +252,7 @@ def test_sigterm_is_handled_as_ctrl_c_checkpoint_written_and_143(tmp_path):
 
 
 def test_ctrl_c_while_a_command_still_imports_its_libraries_is_one_line_and_130(tmp_path):
-    """The installed commands start light (agents/robostrich/commands.py) and note Ctrl-C while they
+    """The installed commands start light (robostrich_commands.py) and note Ctrl-C while they
     import MuJoCo and JAX: Ctrl-C a moment after the start ends the command as Ctrl-C anywhere else
     does, before any work."""
     out = tmp_path / "train"
@@ -268,13 +268,13 @@ def test_ctrl_c_while_a_command_still_imports_its_libraries_is_one_line_and_130(
 def test_the_command_launcher_loads_nothing_heavy_and_knows_every_installed_command():
     import subprocess
     import sys
-    code = ("import sys, agents.robostrich.commands as c; "
+    code = ("import sys, robostrich_commands as c; "
             "print(sorted({m.split('.')[0] for m in sys.modules} & {'numpy', 'jax', 'mujoco', 'dm_control', "
-            "'robostrich_suite', 'matplotlib'}))")
+            "'robostrich_suite', 'agents', 'matplotlib'}))")
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert loaded.strip() == "[]"
     from importlib import metadata
-    from agents.robostrich import commands
+    import robostrich_commands as commands
     installed = {e.name: e.value for e in metadata.entry_points(group="console_scripts")
                  if e.name.startswith("robostrich-")}
     assert set(installed) == set(commands.COMMANDS)

@@ -77,6 +77,20 @@ def test_every_module_imports_with_the_agent_blocked():
     assert f"imported {len(names)}" in result.stdout
 
 
+def test_the_command_launcher_belongs_to_neither_package_and_imports_only_the_standard_library():
+    """robostrich_commands.py, beside both packages, imports importlib, signal and sys (anywhere in
+    the file) and names each command's module as text: importing it loads neither package, and each
+    command's module is a file of its own package."""
+    launcher = ROOT / "robostrich_commands.py"
+    assert set(imported(launcher)) == {"importlib", "signal", "sys"}
+    table = next(node.value for node in ast.parse(launcher.read_text()).body
+                 if isinstance(node, ast.Assign) and [t.id for t in node.targets] == ["COMMANDS"])
+    for target in ast.literal_eval(table).values():
+        module = target.split(":")[0].split(".")
+        assert module[0] in ("robostrich_suite", "agents"), target
+        assert ROOT.joinpath(*module).with_suffix(".py").exists(), target
+
+
 @pytest.mark.parametrize("module", ["robostrich_suite.model.arm", "robostrich_suite.physics"])
 def test_layer_map_is_not_vacuous(module):
     assert layer_of(module) in ("model", "physics")

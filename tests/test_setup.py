@@ -14,7 +14,8 @@ def setup_arguments() -> dict:
     tree = ast.parse((ROOT / "setup.py").read_text())
     call = next(node for node in ast.walk(tree) if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "setup")
     return {kw.arg: ast.literal_eval(kw.value) for kw in call.keywords
-            if kw.arg in ("python_requires", "install_requires", "extras_require", "license", "classifiers")}
+            if kw.arg in ("python_requires", "install_requires", "extras_require", "license", "classifiers",
+                          "py_modules", "entry_points")}
 
 
 def test_python_requires_is_what_the_pinned_dependencies_need():
@@ -66,3 +67,20 @@ def test_readme_python_snippets_run_on_their_own():
             exec(compile(code, f"README.md python snippet {number}", "exec"), {})
         except Exception as error:  # noqa: BLE001 - name the snippet that failed
             raise AssertionError(f"README python snippet {number} fails: {error!r}") from error
+
+
+def test_every_console_script_starts_from_the_launcher_beside_the_packages():
+    """The suite's commands start from the suite's own modules, never through the agent: each console
+    script is an entry of robostrich_commands, installed as a module of its own."""
+    import robostrich_commands
+    arguments = setup_arguments()
+    assert arguments["py_modules"] == ["robostrich_commands"]
+    scripts = dict(line.replace(" ", "").split("=") for line in arguments["entry_points"]["console_scripts"])
+    assert set(scripts) == set(robostrich_commands.COMMANDS)
+    for name, target in scripts.items():
+        assert target == f"robostrich_commands:{name.removeprefix('robostrich-').replace('-', '_')}", name
+    suite = {name for name, module in robostrich_commands.COMMANDS.items() if module.startswith("robostrich_suite.")}
+    assert suite == {"robostrich-movement", "robostrich-workspace", "robostrich-targets", "robostrich-export-xml",
+                     "robostrich-gait", "robostrich-walk", "robostrich-design"}
+    assert all(module.startswith("agents.robostrich.") for name, module in robostrich_commands.COMMANDS.items()
+               if name not in suite)

@@ -361,7 +361,7 @@ def test_bad_input_and_a_missing_ray_are_one_line_and_exit_2(command_env, tmp_pa
     hidden = ("import sys\nclass NoRay:\n    def find_spec(self, name, path=None, target=None):\n"
               "        if name == 'ray' or name.startswith('ray.'):\n            raise ImportError('hidden')\n"
               "sys.meta_path.insert(0, NoRay())\nsys.argv[0] = 'robostrich-sweep'\n"
-              "from agents.robostrich.commands import sweep\nsys.exit(sweep())\n")
+              "from robostrich_commands import sweep\nsys.exit(sweep())\n")
     processes = {
         "no ray": subprocess.Popen([sys.executable, "-c", hidden, "--out", tmp_path / "a"], stdout=subprocess.PIPE,
                                    stderr=subprocess.PIPE, text=True, env=command_env),

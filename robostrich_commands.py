@@ -5,7 +5,10 @@ JAX and matplotlib, which takes seconds. Each entry here imports its command's m
 noted, so Ctrl-C while that happens ends the command as Ctrl-C anywhere else does: one line
 ``PROG: interrupted`` and exit status 130 (robostrich_suite/cli.py), not Python's traceback; SIGTERM
 likewise (``PROG: terminated``, 143).
-Importing this module loads nothing heavy (tests/test_hostile_input.py checks).
+A module of its own beside both packages, not inside either: importing a package runs its
+``__init__`` (robostrich_suite's loads dm_control) before Ctrl-C could be noted, and the suite's
+commands must not start through the agent. It imports only importlib, signal and sys, and names each
+command's module as text (tests/test_hostile_input.py and tests/test_layers.py check).
 """
 import importlib
 import signal
