@@ -4,7 +4,6 @@ The policy network works in [-1, 1]^|A|; `ActionAdapter` maps that box onto
 the BoundedArray spec (e.g. actuator inputs in their own units) and back.
 """
 import jax
-import jax.numpy as jnp
 import numpy as np
 
 
@@ -62,61 +61,54 @@ class ResidualAdapter(ActionAdapter):
 
 
 class Actor:
-    """Runs the policy for one observation per call.
+    """Runs the policy for one observation per call, on the host in numpy.
 
     Stochastic (`deterministic=False`) samples a ~ pi(.|s) for training;
-    deterministic returns tanh(mean) for evaluation. The sampling key is
-    carried inside the jitted call, so a step costs one dispatch.
+    deterministic returns tanh(mean) for evaluation. One observation at a time,
+    numpy does the small network's arithmetic in less time than a jitted call
+    takes to dispatch, so acting never waits on JAX (only `update` converts the
+    learner's new parameters).
     """
 
     def __init__(self, networks, adapter: ActionAdapter, params, key=None, deterministic=False):
-        """`networks`: anything with `sample(params, obs, key) -> (action, log_prob)` and `mode(params, obs)`
-        on batches (e.g. agents.sac.SACNetworks)."""
+        """`networks`: anything with `host_policy_apply(numpy params, obs) -> (mean, log_std)` for one
+        observation (e.g. agents.sac.SACNetworks); ``key``: a JAX PRNG key that seeds the sampling."""
         self.adapter = adapter
-        self.params = params
         self.deterministic = deterministic
+        self._apply = networks.host_policy_apply
         self.key = jax.random.PRNGKey(0) if key is None else key
+        self.rng = self.rng_from_key(self.key)  # the sampling's own stream (a checkpoint keeps its state)
         # Exploration noise correlated over control steps: the Gaussian's standard normal draw
         # follows eps' = rho eps + sqrt(1 - rho^2) n (stationary, unit variance) instead of a
-        # fresh n every step (rho = 0: plain SAC). Needs `networks.policy_apply`.
+        # fresh n every step (rho = 0: plain SAC).
         self.noise_correlation = 0.0
         self.noise = None  # eps, (action size,); None until the first correlated step
+        self.update(params)
 
-        def stochastic(params, obs, key):
-            key, sample_key = jax.random.split(key)
-            action, _ = networks.sample(params, obs[None], sample_key)
-            return action[0], key
-
-        def mode(params, obs):
-            return networks.mode(params, obs[None])[0]
-
-        def correlated(params, obs, key, noise, rho):
-            key, sample_key = jax.random.split(key)
-            fresh = jax.random.normal(sample_key, noise.shape, noise.dtype)
-            noise = rho * noise + jnp.sqrt(1.0 - rho * rho) * fresh
-            mean, log_std = networks.policy_apply(params, obs[None])
-            return jnp.tanh(mean[0] + jnp.exp(log_std[0]) * noise), key, noise
-
-        self._stochastic = jax.jit(stochastic)
-        self._correlated = jax.jit(correlated)
-        self._mode = jax.jit(mode)
+    @staticmethod
+    def rng_from_key(key) -> np.random.Generator:
+        """The numpy generator a JAX key seeds (a checkpoint written before the actor kept one resumes with it)."""
+        return np.random.default_rng(np.asarray(key, np.uint32).ravel().tolist())
 
     def update(self, params):
         self.params = params
+        self._host_params = jax.tree_util.tree_map(np.asarray, params)
 
     def policy_action(self, flat_obs: np.ndarray) -> np.ndarray:
         """Action in [-1, 1]; raises if the network produced NaN/inf."""
+        obs = np.asarray(flat_obs, np.float32)
+        mean, log_std = self._apply(self._host_params, obs, not self.deterministic)
         if self.deterministic:
-            action = self._mode(self.params, flat_obs)
-        elif self.noise_correlation > 0.0:
-            if self.noise is None:  # start from the process' stationary distribution
-                self.key, start_key = jax.random.split(self.key)
-                self.noise = jax.random.normal(start_key, (self.adapter.size,), jnp.float32)
-            action, self.key, self.noise = self._correlated(self.params, flat_obs, self.key, self.noise,
-                                                            jnp.float32(self.noise_correlation))
+            action = np.tanh(mean)
         else:
-            action, self.key = self._stochastic(self.params, flat_obs, self.key)
-        action = np.asarray(action)
+            fresh = self.rng.standard_normal(mean.shape, np.float32)
+            if self.noise_correlation > 0.0:
+                if self.noise is None:  # start from the process' stationary distribution
+                    self.noise = self.rng.standard_normal(mean.shape, np.float32)
+                rho = np.float32(self.noise_correlation)
+                self.noise = rho * self.noise + np.sqrt(np.float32(1.0) - rho * rho) * fresh
+                fresh = self.noise
+            action = np.tanh(mean + np.exp(log_std) * fresh)
         if not np.all(np.isfinite(action)):
             raise ValueError(f"policy produced a non-finite action {action}; observation was {flat_obs}")
         return action

@@ -275,6 +275,7 @@ class CurriculumRun:
             "learner": trees.to_arrays(loop.learner.get_state()),
             "actor_key": np.asarray(loop.actor.key),
             "actor_noise": None if loop.actor.noise is None else np.asarray(loop.actor.noise),
+            "actor_rng": loop.actor.rng.bit_generator.state,
             "replay": loop.replay.state_dict(),
             "loop": loop.state_dict(),
             "lesson_index": self.lesson_index,
@@ -303,6 +304,9 @@ class CurriculumRun:
             raise checkpoint.CheckpointError(f"{path}: {e}") from None
         loop.actor.update(loop.learner.policy_params)
         loop.actor.key = np.asarray(state["actor_key"])
+        loop.actor.rng = loop.actor.rng_from_key(loop.actor.key)
+        if "actor_rng" in state:  # checkpoints written before the actor sampled in numpy have its key alone
+            loop.actor.rng.bit_generator.state = state["actor_rng"]
         noise = state["actor_noise"]
         loop.actor.noise = None if noise is None else np.asarray(noise, np.float32)
         loop.replay.load_state_dict(state["replay"])

@@ -1,6 +1,6 @@
 """EnvironmentLoop: acts, stores transitions, and calls the learner every few steps.
 
-Per agent step the Python work is: one jitted policy call, env.step (times
+Per agent step the Python work is: one numpy pass of the policy on the host, env.step (times
 the action repeat), one flatten and one row insert. The learner is called
 once per `config.env_steps_per_call` transitions with a whole stack of batches.
 """

@@ -243,3 +243,22 @@ def test_replay_flattens_dict_observations_and_wraps():
     batch = replay.sample_stack(2, 5)
     assert batch.obs.shape == (2, 5, 3) and set(batch.reward.ravel()) <= {2, 3, 4, 5}
     np.testing.assert_array_equal(batch.next_obs[..., 0], batch.obs[..., 0] + 1)
+
+
+@pytest.mark.parametrize("hidden, zero_mean", [((16, 16), False), ((8, 8, 8), True)])
+def test_the_actors_numpy_forward_pass_is_the_networks(hidden, zero_mean):
+    """The actor acts with numpy on the host; its mean and spread must be the haiku network's, or
+    training would explore with and evaluation judge another policy than the one learned."""
+    networks = make_networks(OBS, ACT, hidden, zero_policy_mean=zero_mean)
+    params = networks.policy_init(jax.random.PRNGKey(5))
+    obs = np.random.default_rng(0).normal(size=(4, OBS)).astype(np.float32) * 3
+    mean, log_std = (np.asarray(x) for x in networks.policy_apply(params, obs))
+    host = jax.tree_util.tree_map(np.asarray, params)
+    for row in range(4):
+        host_mean, host_log_std = networks.host_policy_apply(host, obs[row])
+        np.testing.assert_allclose(host_mean, mean[row], rtol=1e-5, atol=1e-6)
+        np.testing.assert_allclose(host_log_std, log_std[row], rtol=1e-5, atol=1e-6)
+    actor = Actor(networks, ActionAdapter(specs.BoundedArray((ACT,), np.float64, -1.0, 1.0)), params,
+                  deterministic=True)
+    np.testing.assert_allclose(actor.policy_action(obs[0]), np.tanh(mean[0]), rtol=1e-5, atol=1e-6)
+    assert not zero_mean or np.all(actor.policy_action(obs[1]) == 0.0)

@@ -21,6 +21,7 @@ class SACNetworks:
 
     policy_init: Callable
     policy_apply: Callable  # (params, obs) -> (mean, log_std)
+    host_policy_apply: Callable  # (numpy params, one obs, with_log_std) -> the same in numpy, for acting
     q_init: Callable
     q_apply: Callable  # (params, obs, action) -> (q1, q2), each shape [B]
     obs_size: int
@@ -70,6 +71,11 @@ def _normalised_critic(x, hidden_sizes, name: str):
     return hk.Linear(1, name=f"{name}_head")(x)
 
 
+def _squashed_log_std(raw, log_std_min, log_std_max, tanh):
+    """log_std squashed smoothly into its range (as CleanRL) rather than clipped, which would lose its gradient."""
+    return log_std_min + 0.5 * (log_std_max - log_std_min) * (tanh(raw) + 1.0)
+
+
 @functools.lru_cache(maxsize=None)
 def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max,
                    critic_layer_norm=False, zero_policy_mean=False) -> SACNetworks:
@@ -79,9 +85,20 @@ def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max
         mean_init = hk.initializers.Constant(0.0) if zero_policy_mean else None
         mean = hk.Linear(action_size, w_init=mean_init, name="mean")(h)
         raw = hk.Linear(action_size, name="log_std")(h)
-        # Squash log_std smoothly into its range (as CleanRL) rather than clipping away the gradient.
-        log_std = log_std_min + 0.5 * (log_std_max - log_std_min) * (jnp.tanh(raw) + 1.0)
-        return mean, log_std
+        return mean, _squashed_log_std(raw, log_std_min, log_std_max, jnp.tanh)
+
+    def host_policy_apply(params, obs, with_log_std: bool = True):
+        """policy_fn in numpy: acting on one observation at a time, a jitted call's dispatch costs
+        several times the arithmetic of a small network (tools/benchmark_learner.py measures both)."""
+        h = obs
+        for i in range(len(hidden_sizes)):
+            layer = params[f"policy_torso/~/linear_{i}"]
+            h = np.maximum(h @ layer["w"] + layer["b"], 0.0)
+        mean = h @ params["mean"]["w"] + params["mean"]["b"]
+        if not with_log_std:
+            return mean, None
+        raw = h @ params["log_std"]["w"] + params["log_std"]["b"]
+        return mean, _squashed_log_std(raw, log_std_min, log_std_max, np.tanh)
 
     def q_fn(obs, action):
         x = jnp.concatenate([obs, action], axis=-1)
@@ -100,6 +117,7 @@ def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max
     return SACNetworks(
         policy_init=lambda key: policy.init(key, dummy_obs),
         policy_apply=policy.apply,
+        host_policy_apply=host_policy_apply,
         q_init=lambda key: q.init(key, dummy_obs, dummy_act),
         q_apply=q.apply,
         obs_size=obs_size,
