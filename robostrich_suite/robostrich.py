@@ -22,6 +22,7 @@ from dm_control.utils import containers
 from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite import scenes
 from robostrich_suite.tasks import lessons, reach
+from robostrich_suite.tasks.track import Track
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
 
 TRACK_STEPS_PER_TARGET = 250
@@ -53,7 +54,7 @@ def track(time_limit=None, random=None, environment_kwargs=None, arm_spec=None,
     lessons.check_arm(arm_spec, tendon_layout)
     if targets is None:
         fingerprint_lib.warn_if_other_arm(arm_spec, tendon_layout)
-    task = reach.Track(targets=targets, steps_per_target=steps_per_target, random=random,
+    task = Track(targets=targets, steps_per_target=steps_per_target, random=random,
                        **task_kwargs)
     if time_limit is None:
         time_limit = len(task.targets) * steps_per_target * CONTROL_TIMESTEP

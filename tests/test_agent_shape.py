@@ -1,5 +1,5 @@
-"""The agent's shape: generic modules that name no robot, no function longer than a screen, and
-checkpoints that say which format they are."""
+"""The code's shape: generic modules that name no robot, no function longer than a screen, no module
+over 500 lines, and checkpoints that say which format they are."""
 import ast
 import pathlib
 import re
@@ -9,6 +9,7 @@ GENERIC = sorted(p for p in (ROOT / "agents").rglob("*.py") if "robostrich" not 
 # Words of the robot and its simulator that a generic agent has no business knowing.
 ROBOT_WORDS = re.compile(r"robostrich|mujoco|dm_control|tendon|trunk|geom|quadruped|lookup", re.IGNORECASE)
 MAX_FUNCTION_LINES = 60
+MAX_MODULE_LINES = 500  # a module past this holds more than one job
 # Both packages and the console scripts' launcher beside them.
 PROJECT_MODULES = sorted([*(ROOT / "agents").rglob("*.py"), *(ROOT / "robostrich_suite").rglob("*.py"),
                           ROOT / "robostrich_commands.py"])
@@ -29,6 +30,12 @@ def test_no_function_is_longer_than_a_screen():
                 lines = node.end_lineno - node.lineno + 1
                 if lines > MAX_FUNCTION_LINES:
                     long.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name}: {lines} lines")
+    assert not long, "\n".join(long)
+
+
+def test_no_module_is_longer_than_its_one_job_needs():
+    long = [f"{path.relative_to(ROOT)}: {n} lines" for path in PROJECT_MODULES
+            if (n := len(path.read_text().splitlines())) > MAX_MODULE_LINES]
     assert not long, "\n".join(long)
 
 

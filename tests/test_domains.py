@@ -11,7 +11,8 @@ from agents.robostrich.domains import Domain
 from agents.robostrich.train.main_job import MAIN_JOB_SAC
 from robostrich_suite import targets
 from robostrich_suite.model import layouts
-from robostrich_suite.tasks import quadruped_tasks, reach
+from robostrich_suite.tasks import quadruped_tasks
+from robostrich_suite.tasks.track import default_track_targets
 
 LAYOUT = "antagonist_pairs"
 TINY = dataclasses.replace(MAIN_JOB_SAC, hidden_sizes=(16, 16), batch_size=16, min_replay_size=20,
@@ -43,7 +44,7 @@ def test_a_layout_trains_and_is_judged_on_its_own_targets():
     env = domain.make_environment("lesson2", 0)
     np.testing.assert_array_equal(env.task.target_pool, targets.training_targets(path))
     track = domain.make_environment("track", 0)
-    np.testing.assert_array_equal(track.task.targets, reach.default_track_targets(heldout))
+    np.testing.assert_array_equal(track.task.targets, default_track_targets(heldout))
     table = domain.lookup_table()
     assert np.linalg.norm(table["head_position"][:, None] - heldout[None], axis=2).min() >= 0.01  # no held-out pose
 

@@ -25,6 +25,7 @@ from agents.robostrich.lookup import lookup_table, nearest
 from robostrich_suite import targets
 from robostrich_suite.model import layouts
 from robostrich_suite.tasks import options, quadruped_tasks, reach
+from robostrich_suite.tasks.track import default_track_targets
 
 # Tasks on an arm domain whose episodes start from the fixed pose (held-out
 # evaluation) and continue from the last state (moving starts).
@@ -111,7 +112,7 @@ class Domain:
             return {}
         kwargs = {"tendon_layout": layouts.build(self.layout)}
         if task == TRACK_TASK:
-            kwargs["targets"] = reach.default_track_targets(self.heldout_targets())
+            kwargs["targets"] = default_track_targets(self.heldout_targets())
         elif task.startswith("lesson"):  # head_stabilize and narrow_gap have their own targets
             kwargs["target_pool"] = self._to_domain_frame(targets.training_targets(self._target_file()))
         return kwargs
@@ -163,7 +164,7 @@ class Domain:
         """Start poses of `heldout_moving`: `count` well separated training targets (picked as `track`
         picks its targets) and the stored inputs that hold them (never a held-out pose)."""
         table = self.lookup_table()
-        starts = reach.default_track_targets(
+        starts = default_track_targets(
             self._to_domain_frame(targets.training_targets(self._target_file())), count)
         return starts, np.stack([table["control"][nearest(table, s)] for s in starts])
 

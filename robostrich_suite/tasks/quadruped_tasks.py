@@ -42,7 +42,7 @@ from robostrich_suite.model import legs
 from robostrich_suite.model import quadruped as quad
 from robostrich_suite import scenes
 from robostrich_suite.tasks import gait as gait_lib
-from robostrich_suite.tasks import options, perturbations, reach, target_samplers
+from robostrich_suite.tasks import options, perturbations, reach, target_samplers, track
 
 SETTLE_TIME = 0.2  # s of standing physics before each fresh episode
 LESSON4_TIME_LIMIT = 6.0  # s: stand-in, lowered/raised, back (one height change)
@@ -304,7 +304,7 @@ class QuadrupedReach(_QuadrupedTaskMixin, reach.Reach):
         super().__init__(target_pool=target_pool, **kwargs)
 
 
-class NarrowGap(_QuadrupedTaskMixin, reach.Track):
+class NarrowGap(_QuadrupedTaskMixin, track.Track):
     """Walk up to the wall, stop, track ``GAP_TARGETS`` (fixed in the world) in order.
 
     ``switch`` says when the next sub-target becomes active: ``"time"`` (default, as

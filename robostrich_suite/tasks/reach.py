@@ -7,8 +7,7 @@ Lessons 1-2 start from the fixed pose, lesson 3 from where the last episode ende
 from a pool (:mod:`~robostrich_suite.tasks.target_samplers`).  Every option is a field of
 :class:`ReachConfig`, whose paper values :func:`default_config` gives.
 
-``Track`` is the evaluation task of Fig. 7: a sequence of targets reached in
-order, one after another, within one episode.
+``Track`` (:mod:`~robostrich_suite.tasks.track`) is the evaluation task of Fig. 7 built on it.
 
 Actions are tendon contractions (m); values outside the action spec are
 clipped to it, a NaN action raises ``ValueError``.  A physics divergence ends
@@ -31,16 +30,15 @@ from robostrich_suite.tasks import rewards
 from robostrich_suite.tasks.measurement import Measurement
 from robostrich_suite.tasks.actions import check_action
 from robostrich_suite.tasks.starts import RELEASE_TIME, StartDistribution, check_initial_state
-from robostrich_suite.tasks.target_samplers import MAX_TARGET_DISTANCE, TargetSampler, as_targets
+from robostrich_suite.tasks.target_samplers import MAX_TARGET_DISTANCE, TargetSampler
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG as DESIRED_ATTITUDE
 from robostrich_suite.tasks.conventions import LEVEL_TOLERANCE_DEG as ATTITUDE_TOLERANCE
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, POSITION_TOLERANCE
 
 REWARDS = ("lesson1", "lesson2")
-MAX_STEPS_PER_TARGET = int(options.MAX_SECONDS / CONTROL_TIMESTEP)  # a target held for the longest episode
 
 
-def _length(vector: np.ndarray) -> float:
+def length(vector: np.ndarray) -> float:
     """Euclidean length: np.linalg.norm's own formula, without its checks (a per-step path)."""
     return math.sqrt(vector.dot(vector))
 
@@ -331,7 +329,7 @@ class Reach(base.Task):
         return reading
 
     def position_error(self, physics) -> float:
-        return _length(self.target_position - self.head_xz(physics))
+        return length(self.target_position - self.head_xz(physics))
 
     def attitude_error(self, physics) -> float:
         """Signed head attitude error in degrees (positive = head pitched down), in [-180, 180)."""
@@ -344,7 +342,7 @@ class Reach(base.Task):
         """Everything this task measures now, read once (tasks/measurement.py): the errors and
         success by the same functions as ``get_reward``, ``is_success`` and the observation."""
         head = self.head_xz(physics)
-        position_error = _length(self.target_position - head)
+        position_error = length(self.target_position - head)
         attitude = physics.head_attitude()
         attitude_error = float(physics_lib.attitude_error_deg(attitude, self.desired_attitude))
         return Measurement(position_error, attitude_error,
@@ -446,7 +444,7 @@ class Reach(base.Task):
         to_target = self.target_position - head
         attitude = physics.head_attitude()
         self._head_reading = head, attitude, to_target
-        error = _length(to_target)  # position_error, on this reading
+        error = length(to_target)  # position_error, on this reading
         if self.reward_name == "lesson1":
             if self._samples_failures():
                 self._last_reached = self._within_tolerances(error)  # eq. 9 asks for the position alone
@@ -461,76 +459,3 @@ class Reach(base.Task):
         if self.weights.head_vertical_speed and error <= self.position_tolerance:  # holding, not reaching
             reward -= self.weights.head_vertical_speed * abs(float(physics.head_velocity()[2]))
         return reward
-
-
-class Track(Reach):
-    """Reach ``targets`` in order, ``steps_per_target`` control steps each (Fig. 7)."""
-
-    def __init__(self, targets=None, steps_per_target: int = 250, **kwargs):
-        if targets is None:
-            from robostrich_suite import targets as targets_lib
-            targets = default_track_targets(targets_lib.heldout_targets())
-        targets = as_targets(targets, "targets")
-        steps_per_target = options.whole("steps_per_target", steps_per_target, 1, MAX_STEPS_PER_TARGET,
-                                         "a whole number of control steps")
-        kwargs.setdefault("reward", "lesson2")
-        super().__init__(target_pool=targets, **kwargs)
-        self.targets = targets
-        self.steps_per_target = int(steps_per_target)
-        self.target_index = 0
-        self._step = 0
-
-    def initialize_episode(self, physics):
-        self._step = 0
-        self.target_index = 0
-        super().initialize_episode(physics)
-        # dm_control's base Task calls after_step once while initialising: that is no step of
-        # the episode, so the first target keeps its full steps_per_target.
-        self._step = 0
-        if self.target_index != 0:
-            self.target_index = 0
-            self.target_position = self.targets[0].copy()
-
-    def next_target(self) -> np.ndarray:
-        return self.targets[self.target_index].copy()
-
-    def checkpoint_state(self) -> dict:
-        return {**super().checkpoint_state(), "target_index": self.target_index, "step": self._step}
-
-    def restore_checkpoint_state(self, state: dict) -> None:
-        super().restore_checkpoint_state(state)
-        index = int(state["target_index"])
-        if not 0 <= index < len(self.targets):
-            raise ValueError(f"the stored target index {index} is not one of this task's {len(self.targets)} targets")
-        self.target_index, self._step = index, int(state["step"])
-
-    def after_step(self, physics):
-        super().after_step(physics)
-        self._step += 1
-        index = self.active_target_index(physics)
-        if index != self.target_index:
-            self.target_index = index
-            self.target_position = self.targets[index].copy()
-
-    def active_target_index(self, physics) -> int:
-        """The target after this step: by time, ``steps_per_target`` control steps each
-        (a subclass may switch on something else, e.g. ``NarrowGap(switch="reached")``)."""
-        return min(self._step // self.steps_per_target, len(self.targets) - 1)
-
-    def get_observation(self, physics):
-        obs = super().get_observation(physics)
-        obs["position_error"] = np.array([_length(obs["to_target"])])  # position_error, same reading
-        obs["target_index"] = np.array([float(self.target_index)])
-        return obs
-
-
-def default_track_targets(pool: np.ndarray, count: int = 3) -> np.ndarray:
-    """Three well-separated targets from ``pool``: far forward-low, high, and middle.
-
-    Deterministic, so every evaluation of ``track`` sees the same sequence.
-    """
-    pool = np.asarray(pool)
-    order = [np.argmax(pool[:, 0] - pool[:, 1]),  # forward and low
-             np.argmax(pool[:, 1]),  # highest
-             np.argmin(np.linalg.norm(pool - pool.mean(0), axis=1))]  # central
-    return pool[order[:count]]
