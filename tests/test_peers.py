@@ -6,6 +6,7 @@ import os
 import pathlib
 import subprocess
 import sys
+import tempfile
 
 import numpy as np
 import pytest
@@ -45,13 +46,18 @@ def test_each_peer_trains_through_the_adapter_and_is_scored_by_our_evaluation(ag
     assert len(written["episodes"]) == 1 and written["label"] == f"{agent}_final"
 
 
-def test_a_peer_goes_through_the_lessons_with_its_replay(tmp_path):
-    """'lessons': one agent, the next lesson's environment at each boundary, evaluated at each."""
+def test_a_peer_goes_through_the_lessons_with_its_replay(tmp_path, monkeypatch):
+    """'lessons': one agent, the next lesson's environment at each boundary, evaluated at each; and
+    nothing left in the temporary folder (stable-baselines3 makes a log folder per learn() unless told)."""
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
     plan = (Lesson("robostrich", "lesson1", 60), Lesson("robostrich", "lesson2", 60), Lesson("robostrich", "lesson3", 60))
     spec = tiny_spec("sac", "lessons", plan, tmp_path)
     assert peers.segments(plan, spec.eval_at) == [(0, 60), (1, 60), (2, 60)]
     result = peers.train(spec)
     assert [point["env_steps"] for point in result["curve"]] == [60, 120, 180]
+    assert list(scratch.iterdir()) == []
 
 
 def test_the_peer_actor_gives_contractions_in_the_task_range(tmp_path):

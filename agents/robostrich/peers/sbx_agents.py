@@ -86,7 +86,11 @@ def make_env(domain: Domain, task: str, seed: int, task_kwargs: dict):
 def build_model(agent: str, env, seed: int):
     """The sbx agent with its published defaults; only the seed is ours."""
     sbx = require()
-    return getattr(sbx, PEERS[agent])("MlpPolicy", env, seed=seed, verbose=0)
+    from stable_baselines3.common.logger import Logger  # sbx's own dependency
+    model = getattr(sbx, PEERS[agent])("MlpPolicy", env, seed=seed, verbose=0)
+    # A logger that writes nowhere: without one, every learn() makes an empty SB3-<time> folder in /tmp.
+    model.set_logger(Logger(folder=None, output_formats=[]))
+    return model
 
 
 def segments(plan, eval_at) -> list:
