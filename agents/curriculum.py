@@ -140,12 +140,14 @@ def run_identity(plan: Sequence[Lesson], config: SACConfig, seed: int, lessons: 
 def current_fingerprint(stored: dict) -> dict:
     """A checkpoint's fingerprint as this version writes it for the same run: a field SACConfig no
     longer has is dropped where it holds the value that now goes without saying
-    (SACConfig.REMOVED_FIELDS; another value stays, and then no run matches it)."""
+    (SACConfig.REMOVED_FIELDS; another value stays, and then no run matches it), and a field added
+    since is read as the value that computes what the run computed (SACConfig.ADDED_FIELDS)."""
     config = stored.get("config")
     if not isinstance(config, dict):
         return stored
     removed = SACConfig.REMOVED_FIELDS
-    return {**stored, "config": {k: v for k, v in config.items() if not (k in removed and v == removed[k])}}
+    config = {k: v for k, v in config.items() if not (k in removed and v == removed[k])}
+    return {**stored, "config": {**SACConfig.ADDED_FIELDS, **config}}
 
 
 def run_files(run_dir: str) -> Tuple[str, str, str]:

@@ -51,6 +51,9 @@ class Policy:
     action_high: np.ndarray
     fingerprint: str  # compiled_fingerprint of the environment's model it was trained in
     info: dict  # how it was made: command, seed, domain, task, layout, run fingerprint
+    # The network also reads tanh(gain x observation) after the observation (0: the observation alone),
+    # as the policy was trained (fine inputs: a few millimetres of error read as a large input).
+    fine_input_gain: float = 0.0
 
     @property
     def observation_size(self) -> int:
@@ -70,6 +73,8 @@ class Policy:
     def select_action(self, flat_observation) -> np.ndarray:
         """The environment action for a flattened observation (agents' actor interface)."""
         h = np.asarray(flat_observation, np.float32)
+        if self.fine_input_gain:
+            h = np.concatenate([h, np.tanh(np.float32(self.fine_input_gain) * h)])
         for w, b in self.hidden:
             h = np.maximum(h @ w + b, 0.0)
         squashed = np.tanh(h @ self.mean[0] + self.mean[1]).astype(np.float64)
@@ -109,7 +114,8 @@ class Policy:
         arrays.update(mean_w=self.mean[0], mean_b=self.mean[1], action_low=self.action_low,
                       action_high=self.action_high)
         meta = {"format_version": FORMAT_VERSION, "fingerprint": self.fingerprint,
-                "observation_layout": [list(item) for item in self.observation_layout], "info": self.info}
+                "observation_layout": [list(item) for item in self.observation_layout], "info": self.info,
+                "fine_input_gain": self.fine_input_gain}
         with atomic_files.replaced_atomically(path) as f:
             np.savez_compressed(f, meta=np.array(json.dumps(meta)), **arrays)
 
@@ -129,7 +135,8 @@ def read_policy(path) -> Policy:
                             observation_layout=_observation_layout(path, meta["observation_layout"]),
                             action_low=data["action_low"].astype(np.float64),
                             action_high=data["action_high"].astype(np.float64),
-                            fingerprint=str(meta["fingerprint"]), info=dict(meta.get("info", {})))
+                            fingerprint=str(meta["fingerprint"]), info=dict(meta.get("info", {})),
+                            fine_input_gain=_fine_input_gain(path, meta.get("fine_input_gain", 0.0)))
     except FileNotFoundError:
         raise ValueError(f"{path}: no such policy file") from None
     except (KeyError, OSError, EOFError, zipfile.BadZipFile, TypeError, AttributeError) as error:
@@ -153,6 +160,13 @@ def _metadata(path, stored) -> dict:
         raise ValueError(f"{path}: not a policy file (its metadata lacks the model fingerprint, a string, or "
                          "holds an 'info' that is not an object)")
     return meta
+
+
+def _fine_input_gain(path, gain) -> float:
+    """The metadata's fine_input_gain: a finite number >= 0 (absent in files of policies trained without it)."""
+    if isinstance(gain, bool) or not isinstance(gain, (int, float)) or not (np.isfinite(gain) and gain >= 0):
+        raise ValueError(f"{path}: not a policy file (its fine_input_gain {gain!r} is not a number >= 0)")
+    return float(gain)
 
 
 def _observation_layout(path, layout) -> tuple:
@@ -182,7 +196,8 @@ def check_arrays(policy: Policy, path) -> None:
             raise ValueError(f"{path}: {name} holds non-finite values (NaN or inf): not a usable policy")
     if policy.action_low.ndim != 1:
         raise ValueError(f"{path}: action_low has shape {policy.action_low.shape}, expected (n,): one bound per action")
-    width, actions = policy.observation_size, policy.action_low.shape[0]  # what the next layer reads; gives
+    width = policy.observation_size * (2 if policy.fine_input_gain else 1)  # what the next layer reads
+    actions = policy.action_low.shape[0]
     expected = {}
     for i, _ in enumerate(policy.hidden):
         out = policy.hidden[i][0].shape[-1] if policy.hidden[i][0].ndim == 2 else None
@@ -191,7 +206,8 @@ def check_arrays(policy: Policy, path) -> None:
     expected.update(mean_w=(width, actions), mean_b=(actions,), action_low=(actions,), action_high=(actions,))
     for name, array in arrays:
         if None in expected[name] or array.shape != expected[name]:
-            reads = f" (the observation layout reads {policy.observation_size} values)" if name == "hidden_0_w" else ""
+            reads = (f" (the observation layout reads {policy.observation_size} values"
+                     f"{', twice with its fine inputs' if policy.fine_input_gain else ''})" if name == "hidden_0_w" else "")
             raise ValueError(f"{path}: {name} has shape {array.shape}, expected {_shape(expected[name])}{reads}")
     if not np.all(policy.action_low < policy.action_high):
         raise ValueError(f"{path}: action_low must lie below action_high for every action")

@@ -62,8 +62,10 @@ def test_policy_file_errors_name_the_file(tmp_path):
         policies.load_policy("nope")
 
 
-def test_exported_policy_acts_as_its_runs_evaluation_actor(tmp_path):
-    config = SACConfig(batch_size=16, hidden_sizes=(16, 16), min_replay_size=50, max_replay_size=2000)
+@pytest.mark.parametrize("gain", [0.0, 100.0])
+def test_exported_policy_acts_as_its_runs_evaluation_actor(tmp_path, gain):
+    config = SACConfig(batch_size=16, hidden_sizes=(16, 16), min_replay_size=50, max_replay_size=2000,
+                       fine_input_gain=gain)
     run = DomainRun(parse_plan("lesson1:300"), config, seed=3, run_dir=str(tmp_path / "run"),
                         checkpoint_every=300)
     run.run()
@@ -71,7 +73,7 @@ def test_exported_policy_acts_as_its_runs_evaluation_actor(tmp_path):
     policy = export_policy(str(tmp_path / "run" / "checkpoint.ckpt"), str(path), command="a test")
     again = policies.read_policy(path)
     assert again.info["seed"] == 3 and again.info["command"] == "a test"
-    assert again.info["layout"] == layouts.DEFAULT
+    assert again.info["layout"] == layouts.DEFAULT and again.fine_input_gain == gain
     actor = SACBuilder.make_eval_actor(run.loop)
     env = robostrich_suite.load("robostrich", "lesson1", task_kwargs={"random": 0})
     again.check(env)

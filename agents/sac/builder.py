@@ -42,7 +42,7 @@ class SACBuilder:
         """The networks; a residual policy's mean starts at zero (the base's action)."""
         cfg = self.config
         return make_networks(observation_size, action_size, cfg.hidden_sizes, cfg.log_std_min, cfg.log_std_max,
-                             cfg.critic_layer_norm, zero_policy_mean=residual)
+                             cfg.critic_layer_norm, zero_policy_mean=residual, fine_input_gain=cfg.fine_input_gain)
 
     def make_learner(self, networks, key) -> SACLearner:
         return SACLearner(networks, self.config, key)

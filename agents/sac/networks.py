@@ -49,7 +49,8 @@ def tanh_gaussian_log_prob(u, mean, log_std):
 
 def make_networks(obs_size: int, action_size: int, hidden_sizes: Sequence[int] = (256, 256),
                   log_std_min: float = -5.0, log_std_max: float = 2.0,
-                  critic_layer_norm: bool = False, zero_policy_mean: bool = False) -> SACNetworks:
+                  critic_layer_norm: bool = False, zero_policy_mean: bool = False,
+                  fine_input_gain: float = 0.0) -> SACNetworks:
     """Cached: equal arguments give the same object, so learners and actors share compiled functions.
 
     ``critic_layer_norm`` normalises each hidden layer of the critics (before the ReLU):
@@ -59,7 +60,8 @@ def make_networks(obs_size: int, action_size: int, hidden_sizes: Sequence[int] =
     deterministic action is exactly 0: a residual policy then starts as its base controller.
     """
     return _make_networks(int(obs_size), int(action_size), tuple(int(h) for h in hidden_sizes),
-                          float(log_std_min), float(log_std_max), bool(critic_layer_norm), bool(zero_policy_mean))
+                          float(log_std_min), float(log_std_max), bool(critic_layer_norm), bool(zero_policy_mean),
+                          float(fine_input_gain))
 
 
 def _normalised_critic(x, hidden_sizes, name: str):
@@ -76,11 +78,17 @@ def _squashed_log_std(raw, log_std_min, log_std_max, tanh):
     return log_std_min + 0.5 * (log_std_max - log_std_min) * (tanh(raw) + 1.0)
 
 
+def _with_fine_inputs(obs, gain, tanh, concatenate):
+    """The observation, followed by tanh(gain x observation) where the gain is not 0."""
+    return obs if gain == 0.0 else concatenate([obs, tanh(gain * obs)], axis=-1)
+
+
 @functools.lru_cache(maxsize=None)
 def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max,
-                   critic_layer_norm=False, zero_policy_mean=False) -> SACNetworks:
+                   critic_layer_norm=False, zero_policy_mean=False, fine_input_gain=0.0) -> SACNetworks:
 
     def policy_fn(obs):
+        obs = _with_fine_inputs(obs, fine_input_gain, jnp.tanh, jnp.concatenate)
         h = hk.nets.MLP(hidden_sizes, activation=jax.nn.relu, activate_final=True, name="policy_torso")(obs)
         mean_init = hk.initializers.Constant(0.0) if zero_policy_mean else None
         mean = hk.Linear(action_size, w_init=mean_init, name="mean")(h)
@@ -90,7 +98,7 @@ def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max
     def host_policy_apply(params, obs, with_log_std: bool = True):
         """policy_fn in numpy: acting on one observation at a time, a jitted call's dispatch costs
         several times the arithmetic of a small network (tools/benchmark_learner.py measures both)."""
-        h = obs
+        h = _with_fine_inputs(obs, fine_input_gain, np.tanh, np.concatenate)
         for i in range(len(hidden_sizes)):
             layer = params[f"policy_torso/~/linear_{i}"]
             h = np.maximum(h @ layer["w"] + layer["b"], 0.0)
@@ -101,7 +109,7 @@ def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max
         return mean, _squashed_log_std(raw, log_std_min, log_std_max, np.tanh)
 
     def q_fn(obs, action):
-        x = jnp.concatenate([obs, action], axis=-1)
+        x = jnp.concatenate([_with_fine_inputs(obs, fine_input_gain, jnp.tanh, jnp.concatenate), action], axis=-1)
         if critic_layer_norm:
             q1 = _normalised_critic(x, hidden_sizes, "q1")
             q2 = _normalised_critic(x, hidden_sizes, "q2")
