@@ -116,3 +116,14 @@ def test_without_the_extra_the_command_says_so_in_one_line(tmp_path):
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and "pip install -e '.[peers]'" in lines[0] and "sbx" in lines[0], done.stderr
     assert not out.exists()
+
+
+def test_our_runs_take_the_flags_given_and_a_flag_robostrich_train_lacks_is_one_error():
+    settings = bench.Settings(steps=300, seeds=(0,), agents=("curriculum",), ways=("final",), out="out",
+                              eval_every=100, num_eval_targets=1, final_eval_targets=None, track_task=None,
+                              ours_args=("--fine-input-gain", "0"))
+    argv = bench.ours_argv(settings, "curriculum", 0)
+    assert argv[-2:] == ["--fine-input-gain", "0"] and "--no-baseline" in argv
+    bench.check_ours_args(("--fine-input-gain", "0"))
+    with pytest.raises(ValueError, match="--ours-args: robostrich-train says unrecognized arguments: --bogus"):
+        bench.check_ours_args(("--bogus",))

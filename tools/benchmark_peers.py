@@ -3,6 +3,7 @@ defaults, through robostrich_suite/gym_adapter.py), our curriculum SAC, our plai
 
     python tools/benchmark_peers.py [--steps 100000] [--seeds 0,1] [--ways final,lessons]
                                     [--agents curriculum,plain,sac,tqc,crossq] [--out runs/peers]
+                                    [--ours-args='--fine-input-gain 0']
 
 Every run trains for --steps control steps on the main job's task options and layout: a peer
 either on the final lesson alone ('final') or through the main job's lessons and shares
@@ -60,6 +61,9 @@ def build_parser():
     p.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS),
                    default=min(2, os.cpu_count() or 1), help="runs at a time, one process each (default: %(default)s)")
     p.add_argument("--out", default="runs/peers", help="output directory (default: %(default)s)")
+    p.add_argument("--ours-args", default="",
+                   help="robostrich-train flags our two runs take besides the main job's, e.g. "
+                        "--ours-args='--fine-input-gain 0' for the main job before fine inputs (default: none)")
     p.add_argument("--record-only", action="store_true",
                    help="train nothing: write the record from the runs finished in --out so far (the others are "
                         "named as unfinished), e.g. after the command was stopped")
@@ -81,10 +85,12 @@ def settings_from(args):
     from agents.robostrich.peers import benchmark as bench
     from robostrich_suite import outputs
     outputs.check_directory(args.out)
+    ours_args = tuple(shlex.split(args.ours_args))
+    bench.check_ours_args(ours_args)
     return bench.Settings(steps=args.steps, seeds=args.seeds, agents=args.agents, ways=args.ways, out=args.out,
                           eval_every=args.eval_every or max(1, args.steps // 10),
                           num_eval_targets=args.num_eval_targets, final_eval_targets=args.final_eval_targets,
-                          track_task=args.track_task or None)
+                          track_task=args.track_task or None, ours_args=ours_args)
 
 
 def main(argv=None) -> int:

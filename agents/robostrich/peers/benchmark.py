@@ -40,6 +40,7 @@ class Settings:
     num_eval_targets: int
     final_eval_targets: Optional[int]
     track_task: Optional[str]
+    ours_args: tuple = ()  # robostrich-train flags our runs take besides the main job's
 
 
 def lesson_plan(way: str, steps: int) -> tuple:
@@ -80,7 +81,17 @@ def ours_argv(settings: Settings, label: str, seed: int) -> list:
             "--num-eval-targets", str(settings.num_eval_targets), "--track-task", settings.track_task or ""]
     if settings.final_eval_targets:
         argv += ["--final-eval-targets", str(settings.final_eval_targets)]
-    return argv
+    return argv + list(settings.ours_args)
+
+
+def check_ours_args(ours_args: tuple) -> None:
+    """ValueError naming the flag unless robostrich-train takes ``ours_args`` (checked before any run starts)."""
+    parser = training.build_parser()
+
+    def refuse(message):
+        raise ValueError(f"--ours-args: robostrich-train says {' '.join(message.split())}")
+    parser.error = refuse  # one line from the tool, not robostrich-train's usage and exit
+    parser.parse_args(["--no-baseline", *ours_args])
 
 
 def job_dir(settings: Settings, label: str, seed: int) -> str:

@@ -23,7 +23,7 @@ from agents.robostrich import figures, recording
 from agents.robostrich.evaluate import evaluation
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.robostrich.train.main_job import (DEFAULT_ARM_LAYOUT, DEFAULT_ARM_TASK_KWARGS, DEFAULT_TOTAL_STEPS,
-                                        MAIN_JOB_LESSONS, MAIN_JOB_LESSON_SHARES, MAIN_JOB_SAC, MAIN_JOB_STEPS,
+                                        MAIN_JOB_BY_DOMAIN, MAIN_JOB_LESSON_SHARES, MAIN_JOB_SAC, MAIN_JOB_STEPS,
                                         QUADRUPED_TASK_KWARGS, positive_int)
 from agents.robostrich.train.run_directory import check_run_directory, finished_summary, lock_run_directory, previous_init_path
 from agents.robostrich.domain_run import DEFAULT_LESSONS
@@ -133,10 +133,10 @@ def add_agent_arguments(p) -> None:
     """The agent's settings (SACConfig), what changes per lesson (LessonSettings), the residual and --paper-sac."""
     config_flags.add_config_arguments(p.add_argument_group("SAC (agents/sac/config.py; defaults: the main job's, "
                                                            "agents/robostrich/train/main_job.py MAIN_JOB_SAC)"),
-                                      MAIN_JOB_SAC)
+                                      MAIN_JOB_SAC, MAIN_JOB_BY_DOMAIN)
     lessons = p.add_argument_group("per lesson (agents/curriculum.py LessonSettings; defaults: "
                                    "agents/robostrich/domain_run.py DEFAULT_LESSONS)")
-    config_flags.add_config_arguments(lessons, DEFAULT_LESSONS, MAIN_JOB_LESSONS)
+    config_flags.add_config_arguments(lessons, DEFAULT_LESSONS, MAIN_JOB_BY_DOMAIN)
     lessons.add_argument("--residual-scale", type=float, default=0.0,
                          help="train a residual on the lookup's stored inputs, within this fraction of each "
                               "tendon's half-range (0, the default: the policy gives the whole input)")
