@@ -78,7 +78,7 @@ class SACConfig:
     # only: while policy_average is 0 there is none.
     policy_average_fraction: float = 0.1
     # Each observation entry also enters the networks as tanh(gain x entry) (0 = off, plain SAC): an
-    # error observed in metres or radians is a few hundredths near its goal, where a precise task is
+    # error observed in metres or radians is a few thousandths near its goal, where a precise task is
     # decided; at a gain of 100, 5 mm reads 0.46 instead of 0.005, so the networks need no large weights
     # to tell 5 mm from 10 mm.
     fine_input_gain: float = 0.0
