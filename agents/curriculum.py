@@ -306,9 +306,10 @@ class CurriculumRun:
             raise checkpoint.CheckpointError(f"{path}: {e}") from None
         loop.actor.update(loop.learner.policy_params)
         loop.actor.key = np.asarray(state["actor_key"])
-        loop.actor.rng = loop.actor.rng_from_key(loop.actor.key)
-        if "actor_rng" in state:  # checkpoints written before the actor sampled in numpy have its key alone
+        if "actor_rng" in state:
             loop.actor.rng.bit_generator.state = state["actor_rng"]
+        else:  # checkpoints written before the actor sampled in numpy have its key alone
+            loop.actor.rng = loop.actor.rng_from_key(loop.actor.key)
         noise = state["actor_noise"]
         loop.actor.noise = None if noise is None else np.asarray(noise, np.float32)
         loop.replay.load_state_dict(state["replay"])
