@@ -7,8 +7,6 @@ import re
 import sys
 import typing
 
-from agents.curriculum import LessonSettings
-
 
 def config_flag(field_name: str) -> str:
     """The flag of one config field: ``--field-name``."""
@@ -16,15 +14,16 @@ def config_flag(field_name: str) -> str:
 
 
 def _shown(value, field_name: str = "") -> str:
-    """A default as --help shows it: a tuple as its flag takes it, an empty lesson list by its keyword."""
-    if isinstance(value, tuple) and not value and field_name in LessonSettings.LESSON_LIST_FIELDS:
-        return _EMPTY_LESSONS[field_name == "her_lessons"]
+    """A default as --help shows it: a tuple as its flag takes it, an empty one by its keyword."""
+    if isinstance(value, tuple) and not value:
+        return _empty_keyword(field_name)
     return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
 
 
-# An empty lesson list means every lesson for hindsight goals and no lesson for the rest
-# (LessonSettings): on the command line each is said in a word, `all` or `none`.
-_EMPTY_LESSONS = {True: "all", False: "none"}
+def _empty_keyword(field_name: str) -> str:
+    """How the command line says an empty list: an empty lesson list means every lesson for hindsight
+    goals (LessonSettings), so there it is `all`; elsewhere (no lesson, no fine input) `none`."""
+    return "all" if field_name == "her_lessons" else "none"
 
 
 def add_config_arguments(group, defaults, overrides: typing.Mapping[str, dict] = None):
@@ -56,15 +55,15 @@ def add_config_arguments(group, defaults, overrides: typing.Mapping[str, dict] =
 def _comma_list(item_type, field_name: str = ""):
     """argparse type of a tuple field: the text as given once every item reads as ``item_type``,
     else a usage error naming the flag (int's own words would not). A lesson list's keyword
-    (`all` for hindsight goals, `none` for the rest) reads as the empty list it stands for."""
+    (`all` for hindsight goals, `none` for the rest and for other lists) reads as the empty list it
+    stands for."""
 
     def parse(text: str) -> str:
-        if field_name in LessonSettings.LESSON_LIST_FIELDS:
-            keyword = _EMPTY_LESSONS[field_name == "her_lessons"]
-            if text.strip() == keyword:
-                return ""
-            if not text.strip() and field_name == "her_lessons":  # elsewhere empty means none, as it says
-                raise argparse.ArgumentTypeError(f"name the lessons, separated by commas, or {keyword}")
+        keyword = _empty_keyword(field_name)
+        if text.strip() == keyword:
+            return ""
+        if not text.strip() and field_name == "her_lessons":  # elsewhere empty means none, as it says
+            raise argparse.ArgumentTypeError(f"name the lessons, separated by commas, or {keyword}")
         for item in filter(None, (part.strip() for part in text.split(","))):
             try:
                 item_type(item)

@@ -450,10 +450,15 @@ class ArmPhysicsMixin:
     # episode's last (an unpickled physics starts without one: its state is the live one).
     state_before_reset: tuple | None = None
 
-    def reset(self, keyframe_id=None):
+    def continuing_state(self) -> tuple | None:
+        """What a "continue" episode would start from now: the state and the held tendon inputs
+        (copies), None while the last episode's divergence stands or before any data exists."""
         data = self.__dict__.get("_raw_data")
-        self.state_before_reset = None if data is None or self.divergence is not None else (
+        return None if data is None or self.divergence is not None else (
             data.qpos.copy(), data.qvel.copy(), data.act.copy(), self.arm_control())
+
+    def reset(self, keyframe_id=None):
+        self.state_before_reset = self.continuing_state()
         self.divergence = None
         self.episodes_started += 1
         return super().reset(keyframe_id)

@@ -16,6 +16,7 @@ bounds, the model fingerprint of the robot it was trained on, and how it was tra
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import pathlib
 import zipfile
@@ -54,6 +55,8 @@ class Policy:
     # The network also reads tanh(gain x observation) after the observation (0: the observation alone),
     # as the policy was trained (fine inputs: a few millimetres of error read as a large input).
     fine_input_gain: float = 0.0
+    # ((observation key, gain), ...): those entries also read as tanh(gain x entry), after the above.
+    fine_inputs: tuple = ()
 
     @property
     def observation_size(self) -> int:
@@ -73,12 +76,34 @@ class Policy:
     def select_action(self, flat_observation) -> np.ndarray:
         """The environment action for a flattened observation (agents' actor interface)."""
         h = np.asarray(flat_observation, np.float32)
+        parts = [h]
         if self.fine_input_gain:
-            h = np.concatenate([h, np.tanh(np.float32(self.fine_input_gain) * h)])
+            parts.append(np.tanh(np.float32(self.fine_input_gain) * h))
+        if self.fine_inputs:
+            index, gains = self._fine_entries
+            parts.append(np.tanh(h[index] * gains))
+        h = np.concatenate(parts) if len(parts) > 1 else h
         for w, b in self.hidden:
             h = np.maximum(h @ w + b, 0.0)
         squashed = np.tanh(h @ self.mean[0] + self.mean[1]).astype(np.float64)
         return self.action_low + 0.5 * (squashed + 1.0) * (self.action_high - self.action_low)
+
+    @functools.cached_property
+    def _fine_entries(self):
+        """(flat indices, gains) of ``fine_inputs`` in the observation layout, in its order."""
+        gains, index, weights, start = dict(self.fine_inputs), [], [], 0
+        for key, size in self.observation_layout:
+            if key in gains:
+                index += range(start, start + size)
+                weights += [gains[key]] * size
+            start += size
+        return np.array(index, np.int64), np.array(weights, np.float32)
+
+    @property
+    def input_size(self) -> int:
+        """What the first layer reads: the observation, and its fine inputs."""
+        return (self.observation_size * (2 if self.fine_input_gain else 1)
+                + (self._fine_entries[0].size if self.fine_inputs else 0))
 
     def __call__(self, timestep_or_observation) -> np.ndarray:
         observation = getattr(timestep_or_observation, "observation", timestep_or_observation)
@@ -115,7 +140,7 @@ class Policy:
                       action_high=self.action_high)
         meta = {"format_version": FORMAT_VERSION, "fingerprint": self.fingerprint,
                 "observation_layout": [list(item) for item in self.observation_layout], "info": self.info,
-                "fine_input_gain": self.fine_input_gain}
+                "fine_input_gain": self.fine_input_gain, "fine_inputs": [[k, g] for k, g in self.fine_inputs]}
         with atomic_files.replaced_atomically(path) as f:
             np.savez_compressed(f, meta=np.array(json.dumps(meta)), **arrays)
 
@@ -136,7 +161,8 @@ def read_policy(path) -> Policy:
                             action_low=data["action_low"].astype(np.float64),
                             action_high=data["action_high"].astype(np.float64),
                             fingerprint=str(meta["fingerprint"]), info=dict(meta.get("info", {})),
-                            fine_input_gain=_fine_input_gain(path, meta.get("fine_input_gain", 0.0)))
+                            fine_input_gain=_fine_input_gain(path, meta.get("fine_input_gain", 0.0)),
+                            fine_inputs=_fine_inputs(path, meta.get("fine_inputs", []), meta["observation_layout"]))
     except FileNotFoundError:
         raise ValueError(f"{path}: no such policy file") from None
     except (KeyError, OSError, EOFError, zipfile.BadZipFile, TypeError, AttributeError) as error:
@@ -169,6 +195,22 @@ def _fine_input_gain(path, gain) -> float:
     return float(gain)
 
 
+def _fine_inputs(path, items, layout) -> tuple:
+    """The metadata's fine_inputs: [[observation key, gain > 0], ...], each key one the policy reads
+    (absent in files of policies trained without them)."""
+    keys = {key for key, _ in layout}
+    try:
+        pairs = tuple((key, float(gain)) for key, gain in items
+                      if isinstance(key, str) and not isinstance(gain, (bool, str)))
+    except (TypeError, ValueError):
+        pairs = None
+    if pairs is None or len(pairs) != len(items) or len({k for k, _ in pairs}) != len(pairs) or not all(
+            k in keys and np.isfinite(g) and g > 0 for k, g in pairs):
+        raise ValueError(f"{path}: not a policy file (its fine_inputs {items!r} are not [[key, gain > 0], ...] "
+                         "over keys of its observation layout, each once)")
+    return pairs
+
+
 def _observation_layout(path, layout) -> tuple:
     """((key, size), ...) from the metadata: keys named, sizes whole and positive."""
     try:
@@ -196,7 +238,7 @@ def check_arrays(policy: Policy, path) -> None:
             raise ValueError(f"{path}: {name} holds non-finite values (NaN or inf): not a usable policy")
     if policy.action_low.ndim != 1:
         raise ValueError(f"{path}: action_low has shape {policy.action_low.shape}, expected (n,): one bound per action")
-    width = policy.observation_size * (2 if policy.fine_input_gain else 1)  # what the next layer reads
+    width = policy.input_size  # what the next layer reads
     actions = policy.action_low.shape[0]
     expected = {}
     for i, _ in enumerate(policy.hidden):
@@ -206,8 +248,9 @@ def check_arrays(policy: Policy, path) -> None:
     expected.update(mean_w=(width, actions), mean_b=(actions,), action_low=(actions,), action_high=(actions,))
     for name, array in arrays:
         if None in expected[name] or array.shape != expected[name]:
+            fine = policy.input_size - policy.observation_size
             reads = (f" (the observation layout reads {policy.observation_size} values"
-                     f"{', twice with its fine inputs' if policy.fine_input_gain else ''})" if name == "hidden_0_w" else "")
+                     f"{f', and {fine} fine inputs' if fine else ''})" if name == "hidden_0_w" else "")
             raise ValueError(f"{path}: {name} has shape {array.shape}, expected {_shape(expected[name])}{reads}")
     if not np.all(policy.action_low < policy.action_high):
         raise ValueError(f"{path}: action_low must lie below action_high for every action")

@@ -20,7 +20,7 @@ MAIN_JOB_VALUES = {
     "min_replay_size": 1_000, "max_replay_size": 1_000_000, "updates_per_call": 4, "env_steps_per_call": 4,
     "action_repeat": 1, "reward_scale": 1.0, "log_std_min": -5.0, "log_std_max": 2.0, "critic_layer_norm": True,
     "her_ratio": 0.5, "relabel_rewards": True, "action_anchor": 0.0, "pre_tanh_penalty": 0.1,
-    "policy_average": 1e-4, "policy_average_fraction": 0.1, "fine_input_gain": 0.0}
+    "policy_average": 1e-4, "policy_average_fraction": 0.1, "fine_input_gain": 0.0, "fine_inputs": []}
 
 
 def test_the_main_job_keeps_its_measured_settings_whatever_sacconfig_defaults_to():
@@ -75,8 +75,9 @@ def test_checkpoints_written_before_a_field_was_added_resume_and_evaluate(traine
     fresh = DomainRun(plan, tiny, 0, str(tmp_path / "a"))
     fresh.restore(older)
     assert fresh.loop.env_steps == 80 and evaluation.load_run_from_checkpoint(older).loop.env_steps == 80
-    with pytest.raises(checkpoint.CheckpointError):
-        DomainRun(plan, dataclasses.replace(tiny, fine_input_gain=30.0), 0, str(tmp_path / "b")).restore(older)
+    for changed in ({"fine_input_gain": 30.0}, {"fine_inputs": ("to_target=30",)}):
+        with pytest.raises(checkpoint.CheckpointError):
+            DomainRun(plan, dataclasses.replace(tiny, **changed), 0, str(tmp_path / "b")).restore(older)
 
 
 def test_checkpoints_holding_her_level_goals_resume_and_evaluate(trained, tmp_path):

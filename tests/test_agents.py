@@ -283,3 +283,35 @@ def test_fine_inputs_resolve_small_errors_that_plain_inputs_leave_near_zero():
     assert moved > 20 * np.abs((off - near) @ first["w"][:OBS]).sum()
     with pytest.raises(ValueError, match="fine_input_gain must be a number from 0"):
         SACConfig(fine_input_gain=-1.0)
+
+
+def test_named_fine_inputs_read_only_the_entries_they_name_each_at_its_gain():
+    """fine_inputs ("key=gain" items) resolve to flat entries of the robot's own observation: the error
+    to the target at 100 and the attitude's at 30 add three inputs, each tanh(gain x entry), and leave
+    the joint angles and tendon states as they are; a misnamed key or gain is refused, naming it."""
+    import robostrich_suite
+    flattener = ObservationFlattener(robostrich_suite.load("robostrich", "lesson3").observation_spec())
+    config = SACConfig(fine_inputs=("to_target=100", "attitude_error=30"))
+    start = sum(s for k, s in zip(flattener.keys, flattener.sizes) if k in flattener.keys[:4])
+    entries = config.fine_input_entries(flattener.keys, flattener.sizes)
+    assert SACConfig(fine_inputs="to_target=100, attitude_error=30") == config  # one text, as the flag takes it
+    assert flattener.keys[4:6] == ("to_target", "attitude_error")
+    assert entries == ((start, 100.0), (start + 1, 100.0), (start + 2, 30.0))
+    networks = make_networks(flattener.size, 9, (16, 16), fine_input_entries=entries)
+    params = jax.tree_util.tree_map(np.asarray, networks.policy_init(jax.random.PRNGKey(0)))
+    assert params["policy_torso/~/linear_0"]["w"].shape == (flattener.size + 3, 16)
+    obs = np.zeros(flattener.size, np.float32)
+    obs[start:start + 3] = 0.005, -0.01, np.radians(2.0)  # 5 mm, -1 cm, 2 deg
+    seen = np.concatenate([obs, np.tanh(obs[start:start + 3] * [100.0, 100.0, 30.0])]).astype(np.float32)
+    assert seen[-3:] == pytest.approx([np.tanh(0.5), -np.tanh(1.0), np.tanh(30 * np.radians(2.0))], rel=1e-5)
+    h = seen
+    for i in range(2):
+        h = np.maximum(h @ params[f"policy_torso/~/linear_{i}"]["w"] + params[f"policy_torso/~/linear_{i}"]["b"], 0)
+    mean = h @ params["mean"]["w"] + params["mean"]["b"]
+    np.testing.assert_allclose(networks.host_policy_apply(params, obs)[0], mean, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(np.asarray(networks.policy_apply(params, obs[None])[0])[0], mean, rtol=1e-5, atol=1e-6)
+    for bad, words in ((("gaze=3",), r"names \['gaze'\], which the observation lacks \(it has \['head_position'"),
+                       (("to_target",), "'to_target' is not key=gain"), (("to_target=-1",), "not key=gain"),
+                       (("to_target=1", "to_target=2"), "names 'to_target' twice")):
+        with pytest.raises(ValueError, match=words):
+            SACConfig(fine_inputs=bad).fine_input_entries(flattener.keys, flattener.sizes)

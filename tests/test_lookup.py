@@ -79,6 +79,33 @@ def test_heldout_moving_starts_from_poses_holding_other_targets(flattener):
     assert len({round(e["final_position_error"], 6) for e in report["episodes"]}) > 1
 
 
+def test_one_hold_per_moving_start_scores_every_target_as_a_hold_before_each_target_does(flattener):
+    """The moving-start evaluation brings the arm to each start once and starts every target's episode
+    from that resting state: the episodes must be those of holding the start again before each one."""
+    from robostrich_suite import policies
+    from robostrich_suite.tasks.measurement import measure
+    policy, chosen = policies.load_policy("robostrich"), targets.heldout_targets()[:2]
+    report = evaluation.evaluate_heldout_moving(policy, flattener, "robostrich", targets=chosen)
+    env = make_environment("robostrich", evaluation.MOVING_START_TASK, 30_000, target_pool=chosen[:1])
+    expected = []
+    for start, control in zip(*evaluation.moving_starts()):
+        for target in chosen:  # as the evaluation ran before: hold the start before every target
+            env.task.set_initial_state("fixed")
+            env.task.set_target_pool(start)
+            timestep = env.reset()
+            while not timestep.last():
+                timestep = env.step(control)
+            held = measure(env)
+            env.task.set_initial_state("continue")
+            env.task.set_target_pool(target)
+            row = evaluation._episode_summary(evaluation.rollout(env, policy, flattener))
+            expected.append({**row, "start_position_error": held.position_error})
+    assert len(report["episodes"]) == len(expected) == 6
+    for got, want in zip(report["episodes"], expected):
+        assert {k: got[k] for k in want} == want  # bit for bit
+    assert len({e["final_position_error"] for e in expected}) == 6
+
+
 def test_evaluation_on_reacher_reports_returns_not_nan(tmp_path):
     config = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=200, max_replay_size=5000)
     run = DomainRun(parse_plan("reacher/easy:1000"), config, seed=0, run_dir=str(tmp_path / "run"))

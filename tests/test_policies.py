@@ -50,6 +50,10 @@ def test_policy_file_errors_name_the_file(tmp_path):
     np.savez(bad, something=np.zeros(3))
     with pytest.raises(ValueError, match="bad.npz: not a policy file"):
         policies.load_policy(str(bad))
+    for fine in ((("gaze", 10.0),), (("to_target", -1.0),), (("to_target", 1.0), ("to_target", 2.0))):
+        dataclasses.replace(policies.load_policy("robostrich"), fine_inputs=fine).save(bad)
+        with pytest.raises(ValueError, match=r"bad.npz: not a policy file \(its fine_inputs .* over keys of its"):
+            policies.load_policy(str(bad))
     (tmp_path / "empty.npz").write_bytes(b"")
     with pytest.raises(ValueError, match="empty.npz: not a policy file .not an .npz archive, it is empty"):
         policies.load_policy(str(tmp_path / "empty.npz"))
@@ -62,10 +66,10 @@ def test_policy_file_errors_name_the_file(tmp_path):
         policies.load_policy("nope")
 
 
-@pytest.mark.parametrize("gain", [0.0, 100.0])
-def test_exported_policy_acts_as_its_runs_evaluation_actor(tmp_path, gain):
+@pytest.mark.parametrize("gain, fine", [(0.0, ()), (100.0, ("to_target=100", "attitude_error=30"))])
+def test_exported_policy_acts_as_its_runs_evaluation_actor(tmp_path, gain, fine):
     config = SACConfig(batch_size=16, hidden_sizes=(16, 16), min_replay_size=50, max_replay_size=2000,
-                       fine_input_gain=gain)
+                       fine_input_gain=gain, fine_inputs=fine)
     run = DomainRun(parse_plan("lesson1:300"), config, seed=3, run_dir=str(tmp_path / "run"),
                         checkpoint_every=300)
     run.run()
@@ -74,6 +78,8 @@ def test_exported_policy_acts_as_its_runs_evaluation_actor(tmp_path, gain):
     again = policies.read_policy(path)
     assert again.info["seed"] == 3 and again.info["command"] == "a test"
     assert again.info["layout"] == layouts.DEFAULT and again.fine_input_gain == gain
+    assert again.fine_inputs == tuple((k, float(g)) for k, g in (item.split("=") for item in fine))
+    assert again.hidden[0][0].shape[0] == 46 * (2 if gain else 1) + 3 * bool(fine)  # 2 + 1 fine inputs
     actor = SACBuilder.make_eval_actor(run.loop)
     env = robostrich_suite.load("robostrich", "lesson1", task_kwargs={"random": 0})
     again.check(env)

@@ -38,11 +38,12 @@ class SACBuilder:
             return ResidualAdapter(action_spec, base_policy(flattener), scale)
         return ActionAdapter(action_spec)
 
-    def make_networks(self, observation_size: int, action_size: int, residual: bool = False):
-        """The networks; a residual policy's mean starts at zero (the base's action)."""
+    def make_networks(self, flattener: ObservationFlattener, action_size: int, residual: bool = False):
+        """The networks for ``flattener``'s observations; a residual policy's mean starts at zero (the base's action)."""
         cfg = self.config
-        return make_networks(observation_size, action_size, cfg.hidden_sizes, cfg.log_std_min, cfg.log_std_max,
-                             cfg.critic_layer_norm, zero_policy_mean=residual, fine_input_gain=cfg.fine_input_gain)
+        return make_networks(flattener.size, action_size, cfg.hidden_sizes, cfg.log_std_min, cfg.log_std_max,
+                             cfg.critic_layer_norm, zero_policy_mean=residual, fine_input_gain=cfg.fine_input_gain,
+                             fine_input_entries=cfg.fine_input_entries(flattener.keys, flattener.sizes))
 
     def make_learner(self, networks, key) -> SACLearner:
         return SACLearner(networks, self.config, key)
@@ -63,7 +64,7 @@ class SACBuilder:
         ``residual``: see make_adapter; ``episode_probe(env)``: metrics an episode's record gets from its last state."""
         flattener = ObservationFlattener(env.observation_spec())
         adapter = self.make_adapter(env, flattener, residual)
-        networks = self.make_networks(flattener.size, adapter.size, residual is not None)
+        networks = self.make_networks(flattener, adapter.size, residual is not None)
         learner_key, actor_key = jax.random.split(jax.random.PRNGKey(seed))
         learner = self.make_learner(networks, learner_key)
         replay = self.make_replay(env, flattener, adapter.size, seed)

@@ -82,6 +82,11 @@ class SACConfig:
     # decided; at a gain of 100, 5 mm reads 0.46 instead of 0.005, so the networks need no large weights
     # to tell 5 mm from 10 mm.
     fine_input_gain: float = 0.0
+    # The same for named observation entries only, each at its own gain: "key=gain" items, e.g.
+    # ("to_target=100", "attitude_error=30") reads an error in metres at 100 and one in radians at
+    # 30, so that 1 cm and 2 deg read about alike. Entries of order one would only be squashed to
+    # their signs by a gain this high.
+    fine_inputs: Tuple[str, ...] = ()
 
     # One line per field: what it sets (a training command's --help shows it beside the flag).
     HELP: ClassVar[dict] = {
@@ -109,6 +114,7 @@ class SACConfig:
         "policy_average": "rate of the moving average of the policy that is evaluated and deployed (0: off)",
         "policy_average_fraction": "early on, the average spans this fraction of the updates so far (0: plain average)",
         "fine_input_gain": "each observation entry also enters the networks as tanh(gain x entry) (0: off)",
+        "fine_inputs": "observation entries that also enter as tanh(gain x entry), e.g. to_target=100 (none: off)",
     }
 
     # Upper bounds of the sizes (generous: far beyond any run measured; they keep a typo from
@@ -156,6 +162,9 @@ class SACConfig:
                              f"got {self.policy_average_fraction}")
         if not (np.isfinite(self.fine_input_gain) and 0.0 <= self.fine_input_gain <= 1e6):
             raise ValueError(f"fine_input_gain must be a number from 0 (off) to 1e6, got {self.fine_input_gain}")
+        items = self.fine_inputs.split(",") if isinstance(self.fine_inputs, str) else self.fine_inputs  # as the flag
+        object.__setattr__(self, "fine_inputs", tuple(str(item).strip() for item in items if str(item).strip()))
+        self.fine_input_gains()  # every item read, or the error names it
         if not (np.isfinite(self.pre_tanh_penalty) and self.pre_tanh_penalty >= 0):
             raise ValueError(f"pre_tanh_penalty must be a finite weight >= 0, got {self.pre_tanh_penalty}")
         if not (np.isfinite(self.action_anchor) and self.action_anchor >= 0):
@@ -163,6 +172,38 @@ class SACConfig:
         if self.min_replay_size > self.max_replay_size:
             raise ValueError(f"min_replay_size {self.min_replay_size} exceeds max_replay_size {self.max_replay_size}")
         object.__setattr__(self, "hidden_sizes", tuple(int(h) for h in self.hidden_sizes))
+
+    def fine_input_gains(self) -> dict:
+        """``fine_inputs`` as {observation key: gain}; ValueError naming an item that is not
+        key=gain with a gain from 0 (exclusive) to 1e6, or a key named twice."""
+        gains = {}
+        for item in self.fine_inputs:
+            key, sep, text = item.partition("=")
+            try:
+                gain = float(text) if sep and key.strip() else None
+            except ValueError:
+                gain = None
+            if gain is None or not (np.isfinite(gain) and 0.0 < gain <= 1e6):
+                raise ValueError(f"fine_inputs: {item!r} is not key=gain with a gain above 0 and at most 1e6, "
+                                 "e.g. to_target=100")
+            if key.strip() in gains:
+                raise ValueError(f"fine_inputs names {key.strip()!r} twice")
+            gains[key.strip()] = gain
+        return gains
+
+    def fine_input_entries(self, keys, sizes) -> tuple:
+        """((flat index, gain), ...) of ``fine_inputs`` in an observation of ``keys`` with ``sizes``
+        (an ObservationFlattener's); ValueError naming a key the observation lacks."""
+        gains = self.fine_input_gains()
+        missing = sorted(set(gains) - set(keys or ()))
+        if missing:
+            raise ValueError(f"fine_inputs names {missing}, which the observation lacks "
+                             f"(it has {list(keys) if keys else 'no named entries'})")
+        entries, start = [], 0
+        for key, size in zip(keys or (), sizes):
+            entries += [(start + i, gains[key]) for i in range(size)] if key in gains else []
+            start += size
+        return tuple(entries)
 
     @property
     def update_to_data_ratio(self) -> float:
@@ -175,7 +216,7 @@ class SACConfig:
 
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
-        d["hidden_sizes"] = list(self.hidden_sizes)
+        d["hidden_sizes"], d["fine_inputs"] = list(self.hidden_sizes), list(self.fine_inputs)
         return d
 
     @classmethod
@@ -197,7 +238,7 @@ class SACConfig:
     REMOVED_FIELDS: ClassVar[dict] = {"her_level_goals": False}
     # Fields added since, with the value that computes what configs written before them computed:
     # a stored config without one reads as holding it.
-    ADDED_FIELDS: ClassVar[dict] = {"fine_input_gain": 0.0}
+    ADDED_FIELDS: ClassVar[dict] = {"fine_input_gain": 0.0, "fine_inputs": []}  # as JSON holds them
 
     @classmethod
     def from_dict(cls, d: dict) -> "SACConfig":
@@ -211,6 +252,5 @@ class SACConfig:
         unknown = set(d) - fields
         if unknown:
             raise ValueError(f"unknown SACConfig fields: {sorted(unknown)}")
-        if "hidden_sizes" in d:
-            d = {**d, "hidden_sizes": tuple(d["hidden_sizes"])}
+        d = {**d, **{k: tuple(d[k]) for k in ("hidden_sizes", "fine_inputs") if k in d}}
         return cls(**d)

@@ -50,7 +50,7 @@ def tanh_gaussian_log_prob(u, mean, log_std):
 def make_networks(obs_size: int, action_size: int, hidden_sizes: Sequence[int] = (256, 256),
                   log_std_min: float = -5.0, log_std_max: float = 2.0,
                   critic_layer_norm: bool = False, zero_policy_mean: bool = False,
-                  fine_input_gain: float = 0.0) -> SACNetworks:
+                  fine_input_gain: float = 0.0, fine_input_entries: Sequence = ()) -> SACNetworks:
     """Cached: equal arguments give the same object, so learners and actors share compiled functions.
 
     ``critic_layer_norm`` normalises each hidden layer of the critics (before the ReLU):
@@ -58,10 +58,13 @@ def make_networks(obs_size: int, action_size: int, hidden_sizes: Sequence[int] =
     learn fast at one update per step (Ball et al. 2023, "RLPD").
     ``zero_policy_mean`` starts the policy's mean head at zero weights, so the initial
     deterministic action is exactly 0: a residual policy then starts as its base controller.
+    ``fine_input_gain`` and ``fine_input_entries`` ((index, gain), ...): fine inputs
+    (``_fine_inputs``).
     """
+    entries = tuple((int(i), float(g)) for i, g in fine_input_entries)
     return _make_networks(int(obs_size), int(action_size), tuple(int(h) for h in hidden_sizes),
                           float(log_std_min), float(log_std_max), bool(critic_layer_norm), bool(zero_policy_mean),
-                          float(fine_input_gain))
+                          float(fine_input_gain), entries)
 
 
 def _normalised_critic(x, hidden_sizes, name: str):
@@ -78,17 +81,36 @@ def _squashed_log_std(raw, log_std_min, log_std_max, tanh):
     return log_std_min + 0.5 * (log_std_max - log_std_min) * (tanh(raw) + 1.0)
 
 
-def _with_fine_inputs(obs, gain, tanh, concatenate):
-    """The observation, followed by tanh(gain x observation) where the gain is not 0."""
-    return obs if gain == 0.0 else concatenate([obs, tanh(gain * obs)], axis=-1)
+def _fine_inputs(obs, gain: float, index, gains, np_like):
+    """The observation, followed by tanh(gain x observation) where ``gain`` is not 0, then by
+    tanh(gains[j] x observation[index[j]]) where ``index`` is not None: an error in metres or radians
+    reads a few thousandths near its goal, where a precise task is decided, and tanh(g x) spreads
+    those thousandths over an input of order one (``np_like``: numpy on the host, jax.numpy in the
+    networks)."""
+    parts = [obs]
+    if gain:
+        parts.append(np_like.tanh(np_like.float32(gain) * obs))
+    if index is not None:
+        parts.append(np_like.tanh(obs[..., index] * gains))
+    return parts[0] if len(parts) == 1 else np_like.concatenate(parts, axis=-1)
 
 
 @functools.lru_cache(maxsize=None)
 def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max,
-                   critic_layer_norm=False, zero_policy_mean=False, fine_input_gain=0.0) -> SACNetworks:
+                   critic_layer_norm=False, zero_policy_mean=False, fine_input_gain=0.0,
+                   fine_input_entries=()) -> SACNetworks:
+    if any(not 0 <= i < obs_size for i, _ in fine_input_entries):
+        raise ValueError(f"fine input entries {fine_input_entries} lie outside the observation's {obs_size} entries")
+
+    # built once: the host policy reads them at every control step
+    index = np.array([i for i, _ in fine_input_entries]) if fine_input_entries else None
+    gains = np.array([g for _, g in fine_input_entries], np.float32)
+
+    def with_fine_inputs(obs, np_like=jnp):
+        return _fine_inputs(obs, fine_input_gain, index, gains, np_like)
 
     def policy_fn(obs):
-        obs = _with_fine_inputs(obs, fine_input_gain, jnp.tanh, jnp.concatenate)
+        obs = with_fine_inputs(obs)
         h = hk.nets.MLP(hidden_sizes, activation=jax.nn.relu, activate_final=True, name="policy_torso")(obs)
         mean_init = hk.initializers.Constant(0.0) if zero_policy_mean else None
         mean = hk.Linear(action_size, w_init=mean_init, name="mean")(h)
@@ -98,7 +120,7 @@ def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max
     def host_policy_apply(params, obs, with_log_std: bool = True):
         """policy_fn in numpy: acting on one observation at a time, a jitted call's dispatch costs
         several times the arithmetic of a small network (tools/benchmark_learner.py measures both)."""
-        h = _with_fine_inputs(obs, fine_input_gain, np.tanh, np.concatenate)
+        h = with_fine_inputs(obs, np)
         for i in range(len(hidden_sizes)):
             layer = params[f"policy_torso/~/linear_{i}"]
             h = np.maximum(h @ layer["w"] + layer["b"], 0.0)
@@ -109,7 +131,7 @@ def _make_networks(obs_size, action_size, hidden_sizes, log_std_min, log_std_max
         return mean, _squashed_log_std(raw, log_std_min, log_std_max, np.tanh)
 
     def q_fn(obs, action):
-        x = jnp.concatenate([_with_fine_inputs(obs, fine_input_gain, jnp.tanh, jnp.concatenate), action], axis=-1)
+        x = jnp.concatenate([with_fine_inputs(obs), action], axis=-1)
         if critic_layer_norm:
             q1 = _normalised_critic(x, hidden_sizes, "q1")
             q2 = _normalised_critic(x, hidden_sizes, "q2")

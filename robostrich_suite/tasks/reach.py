@@ -140,6 +140,7 @@ class Reach(base.Task):
         self._last_reached = None
         self._head_reading = None
         self._continues_from_physics = False  # see _continuing_state
+        self._next_start = None  # see continue_next_from
         self._action_change = 0.0  # mean |change| of the tendon inputs at the last step (m), see RewardWeights
         super().__init__(random=random)
 
@@ -212,6 +213,7 @@ class Reach(base.Task):
         self.target_position = self.next_target()
         super().initialize_episode(physics)
         self._continues_from_physics = True
+        self._next_start = None
 
     def _begin_robot(self, physics) -> None:
         """This episode's robot (randomisation, perturbation); a task that must know it before
@@ -225,7 +227,15 @@ class Reach(base.Task):
         """The state a "continue" episode starts from while ``initialize_episode`` runs: where the
         last episode of this task ended (the physics keeps it at each reset), None before this
         task's first episode, after a divergence or after :meth:`forget_last_state`."""
+        if self._next_start is not None:
+            return self._next_start
         return physics.state_before_reset if self._continues_from_physics else None
+
+    def continue_next_from(self, state) -> None:
+        """The next "continue" episode starts from ``state`` (what ``Physics.continuing_state``
+        gave) instead of where the last episode ended: an evaluation that starts many episodes from
+        one resting pose brings the arm there once."""
+        self._next_start = state
 
     def _samples_failures(self) -> bool:
         """Whether the next target is drawn by failure rate (and episodes are scored for it)."""

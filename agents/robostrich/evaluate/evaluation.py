@@ -211,24 +211,22 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
                             on_episode=None) -> dict:
     """Every held-out target from poses where the arm holds another target (lesson 3's situation).
 
-    One lesson-3 environment: per (start, target), an episode from the fixed
-    pose holds the start's stored inputs (2 s: the arm comes to rest there),
-    then the task's `continue` initial state starts the evaluated episode from
-    that final state, with the held-out target.  `starts` = (positions, controls).
+    One lesson-3 environment: per start, an episode from the fixed pose holds
+    the start's stored inputs (2 s: the arm comes to rest there); then, per
+    held-out target, the task's `continue` initial state starts the evaluated
+    episode from that resting state. `starts` = (positions, controls).
     """
     targets = heldout_targets(domain, num_targets) if targets is None else np.asarray(targets, np.float64)
     start_positions, start_controls = moving_starts(domain=domain) if starts is None else starts
     env = make_environment(domain, MOVING_START_TASK, seed, target_pool=targets[:1])
     episodes = []
     for k, (start, control) in enumerate(zip(start_positions, start_controls)):
+        rest, held = _rest_at(env, start, control)
         for target in targets:
-            env.task.set_initial_state("fixed")
-            env.task.set_target_pool(start)
-            timestep = env.reset()
-            while not timestep.last():
-                timestep = env.step(control)
-            held = measure(env)  # where the arm came to rest
             env.task.set_initial_state("continue")
+            if rest is None:  # the hold diverged: from the fixed pose, as a diverged episode's successor
+                env.task.forget_last_state()
+            env.task.continue_next_from(rest)
             env.task.set_target_pool(target)
             row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat))
             row.update(target=np.asarray(target).tolist(), start=k, start_target=np.asarray(start).tolist(),
@@ -238,6 +236,18 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
                 on_episode()
     return {"kind": "heldout_moving", **_names(domain), "task": MOVING_START_TASK, "summary": summarize(episodes),
             "episodes": episodes}
+
+
+def _rest_at(env, start, control):
+    """(the state a `continue` episode starts from, the measurement there) after holding ``control``
+    for an episode from the fixed pose, the target at ``start``: deterministic, so one hold serves
+    every target from that start."""
+    env.task.set_initial_state("fixed")
+    env.task.set_target_pool(start)
+    timestep = env.reset()
+    while not timestep.last():
+        timestep = env.step(control)
+    return env.physics.continuing_state(), measure(env)
 
 
 def evaluate_track(actor, flattener, domain="robostrich", task: str = "track", seed: int = 20_000,

@@ -42,7 +42,7 @@ def export_policy(checkpoint_path: str, out_path: str, command: str = "") -> pol
         action_low=np.broadcast_to(np.asarray(spec.minimum, np.float64), spec.shape).copy(),
         action_high=np.broadcast_to(np.asarray(spec.maximum, np.float64), spec.shape).copy(),
         fingerprint=fingerprint_lib.compiled_fingerprint(env.physics.model),
-        fine_input_gain=run.config.fine_input_gain,
+        fine_input_gain=run.config.fine_input_gain, fine_inputs=tuple(run.config.fine_input_gains().items()),
         info={"layout": domain.layout, **domain.info(), "plan": stored.get("plan"), "seed": run.seed,
               "env_steps": run.loop.env_steps, "command": command, "run_fingerprint": stored})
     env.close()

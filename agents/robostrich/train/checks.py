@@ -10,6 +10,7 @@ from agents.robostrich.evaluate import evaluation
 from agents.robostrich.domains import Domain
 from agents.robostrich.train.main_job import config_from_args, plan_from_args, resolve_layout, resolve_task_kwargs, with_flags
 from agents.robostrich.domain_run import check_lesson_names
+from agents.replay import ObservationFlattener
 from agents.sac.config import SACConfig
 from robostrich_suite import parsing
 from robostrich_suite.tasks import perturbations
@@ -54,16 +55,23 @@ def apply_randomize(scales: Optional[dict], task_kwargs: dict, domain: Domain) -
     return {**task_kwargs, **extra}
 
 
-def check_task_kwargs(plan, layout, task_kwargs: dict) -> None:
+def check_task_kwargs(plan, layout, task_kwargs: dict, config: Optional[SACConfig] = None) -> None:
     """Build each lesson's environment once with ``task_kwargs``, so that an unknown option or a
-    bad value is a one-line error naming --task-kwargs now, not a worker's traceback later."""
+    bad value is a one-line error naming --task-kwargs now, not a worker's traceback later; and
+    ``config``'s fine inputs must name entries each lesson observes (--fine-inputs)."""
     for domain_name, task in dict.fromkeys((lesson.domain, lesson.task) for lesson in plan):
         try:
             env = Domain(domain_name, layout).make_environment(task, 0, **task_kwargs)
         except (TypeError, ValueError) as error:
             raise ValueError(f"--task-kwargs {json.dumps(task_kwargs, default=str)} does not suit "
                              f"{domain_name}/{task}: {error}") from error
+        flattener = ObservationFlattener(env.observation_spec())
         env.close()
+        if config is not None:
+            try:
+                config.fine_input_entries(flattener.keys, flattener.sizes)
+            except ValueError as error:
+                raise ValueError(f"{with_flags(str(error))} in {domain_name}/{task}") from None
 
 
 def check_residual_scale(scale: float, config: SACConfig) -> float:
@@ -118,7 +126,7 @@ def prepare(args, argv) -> TrainingSetup:
         raise ValueError(str(error) if "--layout" in str(error) else f"--layout {args.layout}: {error}") from None
     for lesson in plan:  # a typo fails now, not after the first lessons have trained
         Domain(lesson.domain).check_task(lesson.task)
-    check_task_kwargs(plan, args.layout, args.task_kwargs)
+    check_task_kwargs(plan, args.layout, args.task_kwargs, config)
     domain = dataclasses.replace(domain, sent_actions=args.task_kwargs.get("observe_sent_actions", 0))
     check_goal_free_terms(args.task_kwargs, config)
     try:
