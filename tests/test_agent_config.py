@@ -28,11 +28,12 @@ def test_the_main_job_keeps_its_measured_settings_whatever_sacconfig_defaults_to
     for domain in ("robostrich_a1", "reacher"):  # robostrich-train's flags default to them
         args = command.build_parser().parse_args(["--domain", domain])
         assert main_job.config_from_args(args, ["--domain", domain]) == main_job.MAIN_JOB_SAC
-    # on the frame arm, with fine inputs
+    # on the frame arm, with fine inputs of its two errors; `none` turns them off
     arm = main_job.config_from_args(command.build_parser().parse_args([]), [])
-    assert arm == dataclasses.replace(main_job.MAIN_JOB_SAC, fine_input_gain=100.0)
-    assert main_job.config_from_args(command.build_parser().parse_args(["--fine-input-gain", "0"]),
-                                     ["--fine-input-gain", "0"]) == main_job.MAIN_JOB_SAC
+    assert arm == dataclasses.replace(main_job.MAIN_JOB_SAC, learning_rate=2e-3,
+                                      fine_inputs=("to_target=100", "attitude_error=30"))
+    flags = ["--fine-inputs", "none", "--learning-rate", "1e-3"]
+    assert main_job.config_from_args(command.build_parser().parse_args(flags), flags) == main_job.MAIN_JOB_SAC
 
 
 def test_sacconfig_defaults_to_acmes_sac_with_every_addition_off():

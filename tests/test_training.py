@@ -271,18 +271,19 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
 
 
 def test_main_job_on_the_arm_gives_lesson_3_the_longest_share_and_narrower_noise():
-    """On robostrich the main job's curriculum is 160k / 160k / 280k control steps with lesson 3's
-    target entropy at -3 per tendon; on robostrich_a1 lesson 4 follows from an empty replay; a flag
-    given wins, --paper-sac and other domains keep theirs."""
+    """On robostrich the main job's curriculum is 53k / 53k / 93k control steps with every lesson's
+    target entropy at -3 per tendon; on robostrich_a1 lesson 3 alone is narrowed and lesson 4 follows
+    from an empty replay; a flag given wins, --paper-sac and other domains keep theirs."""
     def made(*argv):
         args = training.build_parser().parse_args(list(argv))
         return (format_plan(main_job.plan_from_args(args)), main_job.config_from_args(args, list(argv)),
                 main_job.config_from_args(args, list(argv), LessonSettings))
 
     plan, config, lessons = made()
-    assert plan == "robostrich/lesson1:160000,robostrich/lesson2:160000,robostrich/lesson3:280000"
-    assert lessons.target_entropy("lesson3", config, 9) == -27.0
-    assert lessons.target_entropy("lesson1", config, 9) == lessons.target_entropy("lesson2", config, 9) == -18.0
+    assert plan == "robostrich/lesson1:53333,robostrich/lesson2:53333,robostrich/lesson3:93334"
+    assert [lessons.target_entropy(f"lesson{k}", config, 9) for k in (1, 2, 3)] == [-27.0] * 3
+    _, config, lessons = made("--exploration-lessons", "lesson3")
+    assert [lessons.target_entropy(f"lesson{k}", config, 9) for k in (1, 2, 3)] == [-18.0, -18.0, -27.0]
     assert made("--steps", "1500")[0] == "robostrich/lesson1:400,robostrich/lesson2:400,robostrich/lesson3:700"
     assert made("--lessons", "lesson1,lesson3", "--steps", "1000")[0] == "robostrich/lesson1:500,robostrich/lesson3:500"
     _, config, lessons = made("--exploration-target-entropy-per-action", "-2.5")
@@ -293,6 +294,7 @@ def test_main_job_on_the_arm_gives_lesson_3_the_longest_share_and_narrower_noise
     assert plan == ("robostrich_a1/lesson1:160000,robostrich_a1/lesson2:160000,robostrich_a1/lesson3:280000,"
                     "robostrich_a1/lesson4:150000")
     assert lessons.exploration_lessons == ("lesson3",) and lessons.fresh_replay_lessons == ("lesson4",)
+    assert config.learning_rate == 1e-3 and config.fine_inputs == ()
     assert made("--domain", "cartpole", "--lessons", "balance")[2].exploration_lessons == ()
 
 

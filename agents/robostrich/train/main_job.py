@@ -22,27 +22,27 @@ MAIN_JOB_SAC = SACConfig(batch_size=64, learning_rate=1e-3, target_entropy_per_a
                          critic_layer_norm=True, her_ratio=0.5, relabel_rewards=True, pre_tanh_penalty=0.1,
                          policy_average=1e-4, policy_average_fraction=0.1)
 DEFAULT_TOTAL_STEPS = 480_000  # per run, split evenly over the lessons; the two runs train side by side
-# The main job on the frame arm: lessons 1-2 keep 160k control steps each and lesson 3, where the
-# policy refines its reach from moving starts, gets the longest share (280k of 600k), training with
-# a narrower policy Gaussian (target entropy -3 per action instead of -2: about 1 % of an input's
-# range instead of 3 %, where a held input 1 % off already costs a target): the long, quiet lesson is
-# what makes the reach precise
-# (docs/log/learning.md#a-longer-quieter-lesson-3-714--within-1-cm-and-2-deg-on-every-seed-2026-12-02).
-# On the quadruped (Algorithm 1 as the paper ran it) lessons 1-3 on the standing quadruped get the
-# frame's 600k, then lesson 4 (trotting, the trunk height changing) 150k more.
-MAIN_JOB_STEPS = {"robostrich": 600_000, "robostrich_a1": 750_000}
+# The main job on the frame arm: 200k control steps, lessons 1-2 keep 53k each and lesson 3, where the
+# policy refines its reach from moving starts, gets the longest share; every lesson trains with a
+# narrower policy Gaussian (target entropy -3 per action instead of -2: about 1 % of an input's range
+# instead of 3 %, where a held input 1 % off already costs a target) at twice the step size (2e-3), and
+# the networks also read fine inputs of the two errors the task is judged by (SACConfig.fine_inputs):
+# tanh(100 x the error to the target in metres) and tanh(30 x the attitude's in radians), so that
+# millimetres and tenths of a degree read as inputs of order one
+# (docs/log/learning.md#fine-inputs-of-the-errors-alone-the-main-job-in-a-third-of-the-steps-2026-12-05).
+# On the quadruped (Algorithm 1 as the paper ran it) lessons 1-3 on the standing quadruped get 600k
+# with lesson 3 alone narrowed, then lesson 4 (trotting, the trunk height changing) 150k more.
+MAIN_JOB_STEPS = {"robostrich": 200_000, "robostrich_a1": 750_000}
 MAIN_JOB_LESSON_SHARES = {"robostrich": (4, 4, 7), "robostrich_a1": (16, 16, 28, 15)}  # of the curriculum, in order
 # Lesson 4 starts with an empty replay: continuing on the standing lessons' transitions, its own
 # success fell while it trained, and with it the standing targets
 # (docs/log/quadruped.md#2026-12-03-hindsight-goals-were-off-lesson-4-after-them-the-head-speed-term).
-# On the frame arm the networks also read fine inputs (SACConfig.fine_input_gain): tanh(100 x each
-# observation), so that millimetres of error read as large inputs; they took the share of held-out
-# targets reached within 1 cm and 2 deg past 80 % at the same budget
-# (docs/log/learning.md#fine-inputs-millimetres-the-networks-can-see-2026-12-05).
-_NARROW_LESSON3 = {"exploration_lessons": ("lesson3",), "exploration_target_entropy_per_action": -3.0}
+_NARROW = {"exploration_target_entropy_per_action": -3.0}
 # Per domain, SACConfig and LessonSettings fields over MAIN_JOB_SAC and DEFAULT_LESSONS.
-MAIN_JOB_BY_DOMAIN = {"robostrich": {**_NARROW_LESSON3, "fine_input_gain": 100.0},
-                      "robostrich_a1": {**_NARROW_LESSON3, "fresh_replay_lessons": ("lesson4",)}}
+MAIN_JOB_BY_DOMAIN = {"robostrich": {**_NARROW, "exploration_lessons": ("lesson1", "lesson2", "lesson3"),
+                                     "learning_rate": 2e-3, "fine_inputs": ("to_target=100", "attitude_error=30")},
+                      "robostrich_a1": {**_NARROW, "exploration_lessons": ("lesson3",),
+                                        "fresh_replay_lessons": ("lesson4",)}}
 MAX_TOTAL_STEPS = 100_000_000  # per run: about three days on 2 CPU cores
 # On the arm domains the main job trains the tasks' own routing, the reconstruction of the paper's
 # Fig. 1B (robostrich_suite.model.layouts.DEFAULT); `--layout antagonist_pairs` trains the best
