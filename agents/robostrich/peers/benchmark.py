@@ -134,6 +134,16 @@ def read_result(settings: Settings, label: str, seed: int) -> Optional[dict]:
         return json.load(f)
 
 
+# The order runs start in, the longest first so that a pool of workers finishes soonest: a run of
+# CrossQ (wide critics) takes longest, then TQC and SAC, and ours minutes where a peer takes tens.
+START_ORDER = ("crossq", "tqc", "sac")
+
+
+def _start_rank(job) -> int:
+    agent = job[0].rsplit("_", 1)[0]
+    return START_ORDER.index(agent) if agent in START_ORDER else len(START_ORDER)
+
+
 def run_all(settings: Settings, workers: int, say=print, train: bool = True) -> dict:
     """Every (run, seed) not finished yet, ``workers`` at a time, each in a fresh single-threaded
     process (none with ``train`` False); {(label, seed): result, None where unfinished}."""
@@ -141,7 +151,7 @@ def run_all(settings: Settings, workers: int, say=print, train: bool = True) -> 
     import multiprocessing
     jobs = [(label, seed) for label in job_labels(settings) for seed in settings.seeds]
     results = {job: read_result(settings, *job) for job in jobs}
-    todo = [job for job in jobs if results[job] is None] if train else []
+    todo = sorted((job for job in jobs if results[job] is None), key=_start_rank) if train else []
     if not todo:
         return results
     os.environ["XLA_FLAGS"] = ((os.environ.get("XLA_FLAGS") or "") + " --xla_cpu_multi_thread_eigen=false"
