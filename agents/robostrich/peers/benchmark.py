@@ -58,7 +58,7 @@ def eval_points(settings: Settings) -> tuple:
 
 
 def job_labels(settings: Settings) -> list:
-    """Run labels, our SAC first (the longest jobs start first)."""
+    """Run labels in the record's order, our SAC first (run_all starts them longest first: START_ORDER)."""
     ours = [a for a in OURS if a in settings.agents]
     return ours + [f"{a}_{w}" for a in peers.PEERS if a in settings.agents for w in settings.ways]
 
