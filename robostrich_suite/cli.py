@@ -120,6 +120,20 @@ def deferred_interrupts():
             _interrupted = False
 
 
+@contextlib.contextmanager
+def held_interrupts():
+    """Ctrl-C and SIGTERM held off while the block makes or takes apart something that must not be
+    left half-made (a Rerun sink: a KeyboardInterrupt raised as Rerun's call returns drops it unread,
+    and Rerun warns on stderr), then acted on: a KeyboardInterrupt once the block is done, unless an
+    enclosing `deferred_interrupts` loop polls for it."""
+    enclosing = _deferred
+    with deferred_interrupts():
+        yield
+        stopped = interrupted()
+    if stopped and not enclosing:
+        raise KeyboardInterrupt
+
+
 def error_message(error: BaseException) -> str:
     """One line: `str(error)`, with an OSError's strerror and file name where it has them."""
     if isinstance(error, OSError) and error.strerror:

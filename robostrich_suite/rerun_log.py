@@ -20,7 +20,6 @@ MuJoCo's are wxyz.
 """
 from __future__ import annotations
 
-import contextlib
 import pathlib
 import re
 
@@ -28,59 +27,89 @@ import mujoco
 import numpy as np
 import rerun as rr
 
-from robostrich_suite import atomic_files
+from robostrich_suite import atomic_files, cli
 
 SIM_TIME = "sim_time"
 DISCARD_FLUSH_SECONDS = 5.0  # a stopped command waits at most this for Rerun's batcher
 
 
 class RecordingFile:
-    """A recording stream encoded in memory: ``close()`` writes it to ``path`` whole (through
-    atomic_files.replaced_atomically, so a failed write names ``path`` and leaves no partial file),
-    ``discard()`` drops it (``path`` keeps what it held). Rerun's own file sink writes from a
-    thread of its own and only logs a failed write; its stream read once, at the end, is the whole
-    .rrd (one read per chunk would make a file of many streams, which Rerun calls corrupt). Memory:
-    the recording's size, a few MB for a minute of the arm. ``blueprint`` (robostrich_suite.rerun_blueprint)
-    goes into the file, so that a viewer opens it in that layout; ``send_blueprint`` can add it later."""
+    """A recording stream encoded in memory, for a ``with`` block that gets the stream: the block's
+    end writes it to ``path`` whole (through atomic_files.replaced_atomically, so a failed write
+    names ``path`` and leaves no partial file), an error or Ctrl-C drops it (``path`` keeps what it
+    held). Rerun's own file sink writes from a thread of its own and only logs a failed write; its
+    stream read once, at the end, is the whole .rrd (one read per chunk would make a file of many
+    streams, which Rerun calls corrupt). Memory: the recording's size, a few MB for a minute of the
+    arm. ``blueprint`` (robostrich_suite.rerun_blueprint) goes into the file, so that a viewer opens
+    it in that layout; ``send_blueprint`` can add it later.
+
+    Rerun's objects exist only between ``open`` and ``close``/``discard``, each made and taken apart
+    with Ctrl-C held off (cli.held_interrupts): Rerun's sink already holds the stream's opening
+    messages when its call returns, and a KeyboardInterrupt raised there would drop it where nothing
+    reads it, with Rerun's warning about dropped data above the command's one line."""
 
     def __init__(self, app_id: str, path: str | pathlib.Path, recording_id: str | None = None,
                  blueprint=None):
         self.path = pathlib.Path(path)
-        self.stream = rr.RecordingStream(app_id, recording_id=recording_id)
-        self.encoded = self.stream.binary_stream()
-        if blueprint is not None:
-            self.send_blueprint(blueprint)
+        self._identity = (app_id, recording_id)
+        self._blueprint = blueprint
+        self.stream: rr.RecordingStream | None = None
+        self.encoded = None
+
+    def open(self) -> rr.RecordingStream:
+        """Make the stream and its in-memory sink; a stop that came meanwhile drops both and is raised."""
+        try:
+            with cli.held_interrupts():
+                app_id, recording_id = self._identity
+                self.stream = rr.RecordingStream(app_id, recording_id=recording_id)
+                self.encoded = self.stream.binary_stream()
+                if self._blueprint is not None:
+                    self.send_blueprint(self._blueprint)
+        except BaseException:
+            self.discard()
+            raise
+        return self.stream
 
     def send_blueprint(self, blueprint) -> None:
         """Make ``blueprint`` the recording's active and default layout."""
         self.stream.send_blueprint(blueprint, make_active=True, make_default=True)
 
     def close(self) -> pathlib.Path:
-        data = self.encoded.read(flush=True) or b""
-        self.stream.disconnect()
+        with cli.held_interrupts():
+            data = self.encoded.read(flush=True) or b""
+            self._disconnect()
         with atomic_files.replaced_atomically(self.path) as handle:
             handle.write(data)
         return self.path
 
     def discard(self) -> None:
         # Everything logged is taken first, as close() does, then whatever the disconnect still
-        # pushes out: data left in the stream when it is dropped makes Rerun warn on stderr.
-        self.encoded.read(flush=True, flush_timeout_sec=DISCARD_FLUSH_SECONDS)
-        self.stream.disconnect()
-        self.encoded.read(flush=False)
+        # pushes out: data left in the sink when it is dropped makes Rerun warn on stderr.
+        with cli.deferred_interrupts():  # the stop (or error) that brought us here goes on after it
+            if self.encoded is not None:
+                self.encoded.read(flush=True, flush_timeout_sec=DISCARD_FLUSH_SECONDS)
+            self._disconnect()
+
+    def _disconnect(self) -> None:
+        if self.stream is not None:
+            self.stream.disconnect()
+        if self.encoded is not None:
+            self.encoded.read(flush=False)
+        self.stream = self.encoded = None
+
+    def __enter__(self) -> rr.RecordingStream:
+        return self.open()
+
+    def __exit__(self, error_type, error, traceback) -> None:
+        """The recording is written if the block ran to its end, dropped otherwise."""
+        self.close() if error_type is None else self.discard()
 
 
-@contextlib.contextmanager
-def recording(app_id: str, path: str | pathlib.Path, recording_id: str | None = None, blueprint=None):
-    """A recording stream for the block, written to ``path`` (an ``.rrd`` file) with ``blueprint``
-    when the block ends without an error, and to no file otherwise (``RecordingFile``)."""
-    file = RecordingFile(app_id, path, recording_id, blueprint)
-    try:
-        yield file.stream
-    except BaseException:
-        file.discard()
-        raise
-    file.close()
+def recording(app_id: str, path: str | pathlib.Path, recording_id: str | None = None,
+              blueprint=None) -> RecordingFile:
+    """A recording stream for a ``with`` block, written to ``path`` (an ``.rrd`` file) with
+    ``blueprint`` when the block ends without an error, and to no file otherwise (``RecordingFile``)."""
+    return RecordingFile(app_id, path, recording_id, blueprint)
 
 
 def set_sim_time(rec: rr.RecordingStream, seconds: float) -> None:

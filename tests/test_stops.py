@@ -207,3 +207,35 @@ def test_ctrl_c_inside_a_garbage_collection_callback_is_kept_for_the_loop_not_pr
     assert result.returncode == 0, result.stderr[-3000:]
     assert result.stdout.split("\n")[:2] == ["interrupted True", "acted on"], result.stdout
     assert "Exception ignored" not in result.stderr, result.stderr[-3000:]
+
+
+STOP_AS_RERUN_OPENS_ITS_SINK = """
+import signal, sys
+from rerun import recording_stream
+from robostrich_suite import cli, rerun_log
+made = recording_stream.BinaryStream.__init__
+def made_as_ctrl_c_lands(self, storage):  # Ctrl-C during Rerun's call is acted on as its wrapper runs
+    signal.raise_signal(signal.SIGINT)
+    made(self, storage)
+recording_stream.BinaryStream.__init__ = made_as_ctrl_c_lands
+cli._install(cli._on_sigint)
+try:
+    with rerun_log.recording("test", sys.argv[1]) as rec:
+        print("block entered")
+except KeyboardInterrupt:
+    print("interrupted")
+"""
+
+
+def test_ctrl_c_while_rerun_opens_its_sink_drops_it_with_no_warning(tmp_path):
+    """Rerun's in-memory sink holds the stream's opening messages as soon as its call returns: a
+    KeyboardInterrupt raised there once dropped it unread, and Rerun printed its warning about
+    dropped data above `robostrich-play: interrupted`. The stop is now acted on once the recording
+    owns the sink, which it then drops: no block, no file, nothing on stderr."""
+    path = tmp_path / "r.rrd"
+    result = subprocess.run([sys.executable, "-c", STOP_AS_RERUN_OPENS_ITS_SINK, str(path)], capture_output=True,
+                            text=True, timeout=120, env=conftest.COMMAND_ENVIRONMENT)
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert result.stdout == "interrupted\n", result.stdout
+    assert result.stderr == "", result.stderr[-3000:]
+    assert not path.exists()

@@ -20,14 +20,15 @@ def _point(vector) -> list:
 
 
 class RolloutRecorder:
-    """Streams one rollout to an .rrd file on a `sim_time` timeline: `close()` once the rollout is
-    whole writes `path`, `discard()` after an error or Ctrl-C leaves no half-written recording."""
+    """Streams one rollout to an .rrd file on a `sim_time` timeline, for a `with` block that opens it
+    (rerun_log.RecordingFile): the block's end writes `path`, an error or Ctrl-C leaves no
+    half-written recording."""
 
     def __init__(self, path: str, name: str = "rollout", application_id: str = "robostrich"):
         from robostrich_suite import rerun_log
         self.path = path
         self.file = rerun_log.RecordingFile(application_id, path, recording_id=name)
-        self.rec = self.file.stream
+        self.rec = None  # the stream, once the `with` block opens it
         self.head_path: List[list] = []
         self.targets: List[list] = []
         self.step = 0
@@ -83,12 +84,15 @@ class RolloutRecorder:
             self.rec.log("world/all_targets", rr.Points3D(self.targets, radii=0.01, colors=[[230, 40, 40]],
                                                           labels=[f"target {i + 1}" for i in range(len(self.targets))]),
                          static=True)
+        self.rec = None  # the file's is then the stream's last reference, dropped with Ctrl-C held off
         self.file.close()
 
     def discard(self):
+        self.rec = None
         self.file.discard()
 
     def __enter__(self):
+        self.rec = self.file.open()
         return self
 
     def __exit__(self, error_type, error, traceback):
