@@ -9,8 +9,13 @@ A module of its own beside both packages, not inside either: importing a package
 ``__init__`` (robostrich_suite's loads dm_control) before Ctrl-C could be noted, and the suite's
 commands must not start through the agent. It imports only importlib, signal and sys, and names each
 command's module as text (tests/test_hostile_input.py and tests/test_layers.py check).
+
+``--help`` answers from the text its parser printed when ``python tools/command_help.py`` last
+wrote ``robostrich_suite/data/help/`` (tests/test_command_help.py checks that it is current), so
+help comes at once instead of after seconds of imports.
 """
 import importlib
+import os
 import signal
 import sys
 
@@ -36,11 +41,35 @@ COMMANDS = {
 }
 
 
+HELP_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "robostrich_suite", "data", "help")
+
+
+def help_path(prog: str) -> str:
+    return os.path.join(HELP_DIR, f"{prog}.txt")
+
+
+def _asks_for_help(argv) -> bool:
+    """-h or --help before any '--': argparse answers it wherever it stands."""
+    for arg in argv:
+        if arg == "--":
+            return False
+        if arg in ("-h", "--help"):
+            return True
+    return False
+
+
 def launch(prog: str) -> int:
-    """Import `prog`'s module and run its cli(). Ctrl-C during the import is noted, not raised (an
-    interrupt raised inside a native module's import can crash the interpreter, and JAX's
-    garbage-collection callback swallows one): the command ends as interrupted once the import is
-    done, before it starts any work."""
+    """Import `prog`'s module and run its cli(); ``--help`` from its stored text, with no import.
+    Ctrl-C during the import is noted, not raised (an interrupt raised inside a native module's
+    import can crash the interpreter, and JAX's garbage-collection callback swallows one): the
+    command ends as interrupted once the import is done, before it starts any work."""
+    if _asks_for_help(sys.argv[1:]):
+        try:
+            with open(help_path(prog), encoding="utf-8") as stored:
+                sys.stdout.write(stored.read())
+            return 0
+        except OSError:  # not written for this command: its parser prints it, after the imports
+            pass
     module, function = COMMANDS[prog].split(":")
     interrupted = []
     previous = {signum: signal.signal(signum, lambda signum, frame: interrupted.append(signum))

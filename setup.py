@@ -16,7 +16,7 @@ setup(
     packages=find_packages(include=["robostrich_suite", "robostrich_suite.*", "agents", "agents.*"]),
     # robostrich_commands.py: the console scripts' light launcher, beside the packages (its docstring says why)
     py_modules=["robostrich_commands"],
-    package_data={"robostrich_suite": ["data/*", "data/policies/*"]},
+    package_data={"robostrich_suite": ["data/*", "data/policies/*", "data/new_targets/*", "data/help/*"]},
     install_requires=[
         "mujoco==3.17.0",
         "dm-control==1.0.50",
@@ -43,7 +43,8 @@ setup(
                  "tfp-nightly==0.26.0.dev20261027",
                  "playwright==1.65.3", "nbclient==0.11.0", "nbformat==5.11.1", "ipykernel==7.4.0",
                  "rerun-notebook==0.41.0"],
-        "notebook": ["ipykernel==7.4.0", "rerun-notebook==0.41.0"],  # docs/tutorial.ipynb, its recording inline
+        # docs/tutorial.ipynb, its recording inline, and jupyter nbconvert --execute, as the notebook says to run it
+        "notebook": ["ipykernel==7.4.0", "rerun-notebook==0.41.0", "nbconvert==7.17.2"],
         "gym": ["gymnasium==1.4.0"],
         "sweep": ["ray==2.60.0"],  # robostrich-sweep: grids of runs as Ray tasks
         "design": ["optuna==5.1.0"],  # robostrich-design: the routing search (its study in SQLite via SQLAlchemy)

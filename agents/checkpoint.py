@@ -20,6 +20,8 @@ import zipfile
 
 import numpy as np
 
+from robostrich_suite import input_files
+
 MAGIC = b"RSACKPTZ"
 # The magic of the pickled checkpoints of format versions 1-2, refused without being unpickled.
 PICKLE_MAGIC = b"RSACKPT1"
@@ -32,6 +34,7 @@ FILE_NAME = "checkpoint.ckpt"
 LESSON_FILE_NAME = "after_lesson{lessons_done}.ckpt"
 PICKLED_FILE_NAME = "checkpoint.pkl"
 
+MAX_CHECKPOINT_BYTES = 8 << 30  # a run's state with its whole replay: far more than 10M transitions take
 _LENGTH = struct.Struct("<Q")
 # Markers of the header's non-JSON values; a payload's own keys starting with "$" get one more "$".
 _ARRAY, _SCALAR, _TUPLE = "$array", "$scalar", "$tuple"
@@ -174,8 +177,10 @@ def _read_record(path: str) -> dict:
 def read_with_digest(path: str) -> tuple:
     """(record, hex sha256 of its content) after the checks of :func:`_read_record`: the digest names
     this checkpoint's content (a run started from it records it)."""
-    with open(path, "rb") as f:
-        data = f.read()
+    try:
+        data = input_files.read_bytes(path, MAX_CHECKPOINT_BYTES, "checkpoint")
+    except ValueError as error:
+        raise CheckpointError(str(error)) from None
     if data[:len(PICKLE_MAGIC)] == PICKLE_MAGIC:
         raise CheckpointError(f"{path} is a checkpoint of format version 2 or earlier, written with pickle, which "
                               f"this version does not read (loading a pickle can run code); train it again, or "
@@ -215,6 +220,7 @@ def _parse(content: memoryview) -> dict:
     if not zipfile.is_zipfile(body):  # numpy would read anything else as one array, or a pickle it refuses
         raise ValueError("the body is not an .npz archive")
     body.seek(0)
+    input_files.check_npz(body, "its body", MAX_CHECKPOINT_BYTES)
     with np.load(body, allow_pickle=False) as archive:
         arrays = _Arrays(archive)
         return {"format_version": FORMAT_VERSION, "fingerprint": _decode(header.get("fingerprint"), arrays),

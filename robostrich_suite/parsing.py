@@ -12,6 +12,8 @@ import json
 import os
 import tomllib
 
+from robostrich_suite import input_files
+
 MAX_DEPTH = 64  # levels of nested arrays and objects; what the project writes stays under 10
 
 
@@ -68,8 +70,9 @@ def loads_toml(text, source=None, max_depth: int = MAX_DEPTH) -> dict:
 
 
 def _read(path) -> bytes:
-    with open(path, "rb") as f:  # a missing or unreadable file is an OSError naming it
-        return f.read()
+    """A missing or unreadable file is an OSError naming it; a FIFO, a device or a file of over
+    input_files.MAX_TEXT_BYTES a ValueError (robostrich_suite/input_files.py)."""
+    return input_files.read_bytes(path, input_files.MAX_TEXT_BYTES, "text file")
 
 
 def read_json(path, max_depth: int = MAX_DEPTH):

@@ -20,14 +20,16 @@ import functools
 import json
 import pathlib
 import zipfile
+import zlib
 
 import numpy as np
 
 from robostrich_suite import atomic_files
 from robostrich_suite import fingerprint as fingerprint_lib
-from robostrich_suite import parsing
+from robostrich_suite import input_files, parsing
 
 FORMAT_VERSION = 1
+MAX_POLICY_BYTES = 64 << 20  # a policy file, packed or unpacked: the shipped ones are tens of kB
 POLICY_DIR = pathlib.Path(__file__).parent / "data" / "policies"
 # The shipped policies by name (a domain's default robot and task family).
 SHIPPED = {"robostrich": POLICY_DIR / "robostrich_curriculum.npz",  # the arm on its frame
@@ -150,9 +152,8 @@ def read_policy(path) -> Policy:
     the version this code reads."""
     path = pathlib.Path(path)
     try:
-        if not zipfile.is_zipfile(path):  # numpy would read anything else as a pickle it then refuses
-            raise ValueError(f"{path}: not a policy file (not an .npz archive{', it is empty' if path.stat().st_size == 0 else ''})")
-        with np.load(path, allow_pickle=False) as data:
+        archive = input_files.npz_bytes(path, MAX_POLICY_BYTES, MAX_POLICY_BYTES, "policy file")
+        with np.load(archive, allow_pickle=False) as data:
             meta = _metadata(path, data["meta"])
             count = sum(1 for key in data.files if key.startswith("hidden_") and key.endswith("_w"))
             hidden = tuple((data[f"hidden_{i}_w"], data[f"hidden_{i}_b"]) for i in range(count))
@@ -165,7 +166,7 @@ def read_policy(path) -> Policy:
                             fine_inputs=_fine_inputs(path, meta.get("fine_inputs", []), meta["observation_layout"]))
     except FileNotFoundError:
         raise ValueError(f"{path}: no such policy file") from None
-    except (KeyError, OSError, EOFError, zipfile.BadZipFile, TypeError, AttributeError) as error:
+    except (KeyError, OSError, EOFError, zipfile.BadZipFile, zlib.error, TypeError, AttributeError) as error:
         raise ValueError(f"{path}: not a policy file ({type(error).__name__}: {error})") from None
     check_arrays(policy, path)
     return policy

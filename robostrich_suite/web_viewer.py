@@ -14,10 +14,12 @@ The command then waits: Ctrl-C stops the servers (exit 130, robostrich_suite/cli
 from __future__ import annotations
 
 import argparse
+import ctypes
 import os
 import pathlib
 import shutil
 import socket
+import signal
 import subprocess
 import sys
 import tempfile
@@ -26,6 +28,7 @@ import urllib.parse
 
 HOST = "127.0.0.1"
 DEFAULT_PORT = 9090  # the port Rerun's own web viewer uses
+PR_SET_PDEATHSIG = 1  # prctl(2): the signal a child gets when its parent ends
 START_TIMEOUT = 60.0  # s for the servers to listen: the rerun program is large and the machine may be busy
 
 
@@ -118,7 +121,7 @@ def serve(paths, web_port: int, out=sys.stdout) -> None:
                "--port", str(grpc_port), *paths]
     with tempfile.TemporaryFile() as log:
         process = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
-                                   env={**os.environ, "RUST_LOG": "warn"})
+                                   env={**os.environ, "RUST_LOG": "warn"}, preexec_fn=_ended_with_this_process())
         try:
             _wait_until_listening(process, (web_port, grpc_port), log)
             print(f"serving {len(paths)} recording{'s' * (len(paths) > 1)} in Rerun's web viewer: "
@@ -127,6 +130,21 @@ def serve(paths, web_port: int, out=sys.stdout) -> None:
             raise ValueError(f"the web viewer stopped (rerun exited with {returncode}): {_last_line(log)}")
         finally:
             _stop(process)
+
+
+def _ended_with_this_process():
+    """For Popen's preexec_fn: on Linux the server gets SIGTERM when this process ends, however it
+    ends (SIGKILL too, which runs no cleanup here), instead of listening on with no one to stop it;
+    None elsewhere. prctl is looked up before the fork, so the child only calls it."""
+    if not sys.platform.startswith("linux"):
+        return None
+    prctl, parent = ctypes.CDLL(None, use_errno=True).prctl, os.getpid()
+
+    def in_child():
+        prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+        if os.getppid() != parent:  # this process ended before the call: the signal will not come
+            os._exit(1)
+    return in_child
 
 
 def _stop(process: subprocess.Popen) -> None:

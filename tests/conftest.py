@@ -13,6 +13,8 @@ import sys
 
 import pytest
 
+ROOT = pathlib.Path(__file__).resolve().parents[1]  # the repository
+
 os.environ.setdefault("MUJOCO_GL", "egl")
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent / "tools"))
 

@@ -67,7 +67,8 @@ def test_train_exits_zero_and_writes_its_run(trained):
     lines = result.stdout.strip().splitlines()  # a few lines a person reads; the JSON stays in the files
     assert lines[0].startswith("curriculum ") and "% reached (" in lines[0] and "within 1 cm and 2 deg" in lines[0]
     assert any(line.startswith("lookup ") for line in lines) and "{" not in result.stdout
-    assert lines[-1].startswith(f"wrote {out}/: summary.json") and len(lines) <= 8, result.stdout
+    assert [line.split()[0] for line in lines[:5]] == ["curriculum", "heldout_moving", "new", "new_moving", "track"]
+    assert lines[-1].startswith(f"wrote {out}/: summary.json") and len(lines) <= 11, result.stdout
     assert not (out / ".lock").exists()  # a clean end leaves only the results
 
 
@@ -89,11 +90,23 @@ def test_evaluate_exits_zero_on_a_checkpoint(trained, tmp_path):
     assert_succeeded(result)
     assert (tmp_path / "ev" / "summary.json").stat().st_size > 0
     lines = result.stdout.strip().splitlines()
-    firsts = ["eval", "heldout_moving", "track", "lookup", "heldout_moving", "track"]  # label, then its kinds
+    kinds = ["heldout_moving", "new", "new_moving", "track"]
+    firsts = ["eval", *kinds, "lookup", *kinds]  # label, then its kinds
     assert [line.split()[0] for line in lines[:-1]] == firsts and lines[0].split()[1] == "heldout", result.stdout
     assert lines[-1] == f"wrote {tmp_path / 'ev'}/: summary.json, reports", result.stdout
     # the evaluation's progress bar, ending at all its episodes (what it shows before depends on the speed)
     assert re.search(r"evaluation: 100%.* (\d+)/\1 \[", result.stderr) and "episode" in result.stderr, result.stderr
+
+
+def test_a_checkpoint_whose_stored_plan_is_damaged_is_named_in_one_line(trained, tmp_path):
+    _, out = trained
+    record = checkpoint._read_record(str(out / "curriculum" / "checkpoint.ckpt"))
+    damaged = tmp_path / "damaged.ckpt"
+    checkpoint.save(str(damaged), record["payload"], {**record["fingerprint"], "plan": "robostrich/lesson1:abc"})
+    result = call("robostrich-evaluate", damaged, "--out", tmp_path / "ev", "--num-targets", "1")
+    lines = result.stderr.strip().splitlines()
+    assert result.returncode == 2 and len(lines) == 1, result.stderr[-3000:]
+    assert lines[0].startswith(f"robostrich-evaluate: error: {damaged} holds a damaged plan: "), lines[0]
 
 
 def test_train_runs_on_the_quadruped_and_on_another_layout(tmp_path):

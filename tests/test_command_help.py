@@ -6,6 +6,7 @@ import re
 from agents.curriculum import LessonSettings
 from agents.sac.config import SACConfig
 from robostrich_commands import COMMANDS
+import conftest
 from conftest import run_in_one_process
 
 FLAG = re.compile(r"^  (-\w, )?(--[\w-]+)(.*)$")
@@ -93,3 +94,43 @@ def test_every_flag_with_a_default_shows_it_in_words():
     silent = {f"{prog} {flag}": text for prog, flags in helps.items() for flag, text in flags.items()
               if "default" not in text or re.search(r"default: *[;)]", text)}
     assert not silent, silent
+
+
+def test_the_stored_help_of_every_command_is_what_its_parser_prints():
+    """The launcher's --help text (robostrich_suite/data/help/) is written by tools/command_help.py
+    from each command's own parser: one source, checked here, so a changed flag cannot leave it stale."""
+    import subprocess
+    import sys
+    result = subprocess.run([sys.executable, "tools/command_help.py", "--check"], capture_output=True, text=True,
+                            timeout=300, cwd=conftest.ROOT)
+    assert result.returncode == 0, result.stderr[-3000:]
+
+
+HELP_WITHOUT_IMPORTS = r'''
+import contextlib, io, json, sys
+import robostrich_commands
+shown = {}
+for prog in robostrich_commands.COMMANDS:
+    sys.argv = [prog, "--help"]
+    with contextlib.redirect_stdout(io.StringIO()) as out:
+        status = robostrich_commands.launch(prog)
+    shown[prog] = [status, out.getvalue().startswith(f"usage: {prog} ")]
+print(json.dumps({"shown": shown, "heavy": sorted(m for m in ("jax", "mujoco", "dm_control", "matplotlib")
+                                                  if m in sys.modules)}))
+'''
+
+
+def test_help_answers_before_any_heavy_import():
+    """`robostrich-X --help` prints its usage and exits 0 having imported neither JAX nor MuJoCo
+    (seconds of imports before: 7-9 s on two cores), for every command, and as an installed script."""
+    import json
+    import subprocess
+    import sys
+    result = subprocess.run([sys.executable, "-c", HELP_WITHOUT_IMPORTS], capture_output=True, text=True, timeout=120,
+                            cwd=conftest.ROOT)
+    assert result.returncode == 0, result.stderr[-3000:]
+    report = json.loads(result.stdout)
+    assert report["heavy"] == [] and report["shown"] == {prog: [0, True] for prog in COMMANDS}, report
+    installed = subprocess.run([conftest.console_script("robostrich-train"), "--help"], capture_output=True, text=True,
+                               timeout=120)
+    assert installed.returncode == 0 and installed.stdout.startswith("usage: robostrich-train "), installed.stderr

@@ -11,7 +11,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "robostrich_suite"
 # Each module's layer; a module may import from its own layer and the ones below it.
 LAYERS = ("utilities", "model", "physics", "tasks", "domains", "studies")
-TOP_LEVEL = {"cli": "utilities", "rerun_log": "utilities", "rerun_blueprint": "utilities", "web_viewer": "utilities", "atomic_files": "utilities", "outputs": "utilities",
+TOP_LEVEL = {"cli": "utilities", "rerun_log": "utilities", "rerun_blueprint": "utilities", "web_viewer": "utilities", "atomic_files": "utilities", "input_files": "utilities", "outputs": "utilities",
              "parallel": "utilities", "progress": "utilities", "parsing": "utilities", "targets": "model", "physics": "physics", "quadruped_physics": "physics",
              "scenes": "physics", "fingerprint": "physics", "robostrich": "domains",
              "robostrich_a1": "domains", "gym_adapter": "domains", "policies": "domains",
@@ -78,11 +78,11 @@ def test_every_module_imports_with_the_agent_blocked():
 
 
 def test_the_command_launcher_belongs_to_neither_package_and_imports_only_the_standard_library():
-    """robostrich_commands.py, beside both packages, imports importlib, signal and sys (anywhere in
+    """robostrich_commands.py, beside both packages, imports importlib, os, signal and sys (anywhere in
     the file) and names each command's module as text: importing it loads neither package, and each
     command's module is a file of its own package."""
     launcher = ROOT / "robostrich_commands.py"
-    assert set(imported(launcher)) == {"importlib", "signal", "sys"}
+    assert set(imported(launcher)) == {"importlib", "os", "signal", "sys"}
     table = next(node.value for node in ast.parse(launcher.read_text()).body
                  if isinstance(node, ast.Assign) and [t.id for t in node.targets] == ["COMMANDS"])
     for target in ast.literal_eval(table).values():

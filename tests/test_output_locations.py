@@ -152,7 +152,7 @@ def test_a_full_disk_is_one_line_naming_the_file_and_leaves_no_partial_file(tmp_
                                          "--out", tmp_path / "walk"),
                  ["File too large", str(tmp_path / "walk" / "walk.rrd")]),
         "play": (start_with_a_full_disk("robostrich-play", "--num-targets", "1", "--out", tmp_path / "play"),
-                 ["File too large", str(tmp_path / "play" / "policy_track.rrd")]),
+                 ["File too large", str(tmp_path / "play" / "robostrich_track.rrd")]),
         "train": (start_with_a_full_disk("robostrich-train", *TINY_TRAIN, "--out", tmp_path / "train"),
                   ["File too large: " + str(tmp_path / "train"), "checkpoint.ckpt"]),
     }

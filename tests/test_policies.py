@@ -96,10 +96,10 @@ def test_play_runs_the_shipped_policy_as_an_installed_command(tmp_path):
                             cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stderr[-3000:]
     assert "track    100.0 % reached" in result.stdout, result.stdout
-    report = json.loads((tmp_path / "played" / "policy_heldout.json").read_text())
+    report = json.loads((tmp_path / "played" / "robostrich_heldout.json").read_text())
     assert report["summary"]["episodes"] == 2
-    assert (tmp_path / "played" / "policy_track.png").stat().st_size > 10_000
-    assert (tmp_path / "played" / "policy_track.rrd").stat().st_size > 0
+    assert (tmp_path / "played" / "robostrich_track.png").stat().st_size > 10_000
+    assert (tmp_path / "played" / "robostrich_track.rrd").stat().st_size > 0
     bad = subprocess.run([console_script("robostrich-play"), "--policy", "nope.npz"], cwd=tmp_path,
                          capture_output=True, text=True, timeout=300)
     assert bad.returncode == 2 and bad.stderr.strip().count("\n") == 0, bad.stderr
@@ -113,10 +113,24 @@ def test_play_runs_the_quadrupeds_shipped_policy_on_held_out_targets_and_head_st
                              "--out", "played"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stderr[-3000:]
     assert "heldout  100.0 % reached" in result.stdout, result.stdout
-    stabilize = json.loads((tmp_path / "played" / "policy_head_stabilize.json").read_text())["summary"]
+    stabilize = json.loads((tmp_path / "played" / "robostrich_a1_head_stabilize.json").read_text())["summary"]
     assert stabilize["height_rms_error"] < 0.01 and stabilize["attitude_within_fraction"] > 0.9, stabilize
     assert stabilize["distance_mean_error"] < 0.02 and not stabilize["fell"], stabilize
-    assert (tmp_path / "played" / "policy_stabilize.png").stat().st_size > 10_000
-    assert (tmp_path / "played" / "stabilize_policy.rrd").stat().st_size > 0
+    assert (tmp_path / "played" / "robostrich_a1_head_stabilize.png").stat().st_size > 10_000
+    assert (tmp_path / "played" / "robostrich_a1_head_stabilize.rrd").stat().st_size > 0
     with pytest.raises(policies.PolicyMismatch):
         robostrich_suite.load_policy("robostrich_a1", robostrich_suite.load("robostrich", "lesson2"))
+
+
+def test_two_policies_played_into_one_folder_keep_their_own_files(tmp_path):
+    """Each file is named after its policy: the second policy's reports do not overwrite the first's."""
+    out = tmp_path / "played"
+    for policy in ("robostrich", "robostrich_robust"):
+        result = subprocess.run([console_script("robostrich-play"), "--policy", policy, "--num-targets", "1",
+                                 "--no-rerun", "--out", str(out)], capture_output=True, text=True, timeout=600)
+        assert result.returncode == 0, result.stderr[-3000:]
+    names = sorted(p.name for p in out.iterdir())
+    assert names == sorted(f"{policy}_{kind}" for policy in ("robostrich", "robostrich_robust")
+                           for kind in ("heldout.json", "track.json", "track.png")), names
+    for policy in ("robostrich", "robostrich_robust"):
+        assert json.loads((out / f"{policy}_heldout.json").read_text())["policy"] == policy

@@ -226,6 +226,17 @@ def test_the_command_writes_its_figure_json_and_a_results_record(tmp_path):
         assert [r["scale"] for r in rows] == [0.0, 0.3]
         assert rows[0] == report["results"]["policy"]["mass"][0]  # scale 0: the one nominal robot
         assert rows[1]["heldout"]["episodes"] == 2 and rows[1]["heldout_moving"]["episodes"] == 6
+    # what it prints agrees with its JSON for every policy, family and start: a fall below 90 % anywhere is said
+    printed = result.stdout.splitlines()
+    for label, families in report["results"].items():
+        block = printed[printed.index(next(l for l in printed if l.startswith(f"{label}: "))):]
+        for family, rows in families.items():
+            line = next(l for l in block if l.split()[:1] == [family])
+            for kind, words in (("heldout", "fixed start: "), ("heldout_moving", "moving starts: ")):
+                below = [r["scale"] for r in rows if r[kind]["success_rate"] < 0.9]
+                said = line.split(words, 1)[1].split(";")[0]
+                assert said.startswith(f"below 90 % at s = {below[0]}") if below else said.startswith("above 90 %"), \
+                    (label, family, kind, line)
     record = results_page.make_record("robustness_test", str(out / "robustness.json"), "Robustness")
     assert record["kind"] == "robustness" and record["command"].startswith("robostrich-robustness robostrich_robust")
     section = results_page.render_record(record)

@@ -1,6 +1,9 @@
 """What setup.py promises matches what its pinned dependencies need, and the README says the same."""
 import ast
+import code
+import contextlib
 import importlib.metadata
+import io
 import pathlib
 import re
 
@@ -57,16 +60,22 @@ def test_readme_states_the_same_python_version():
     assert stated == {floor}, f"README says Python {stated}, setup.py {floor}+"
 
 
-def test_readme_python_snippets_run_on_their_own():
-    """Each ```python block of the README runs in a fresh namespace: it imports what it uses."""
+def test_readme_python_snippets_run_pasted_into_the_interpreter():
+    """Each ```python block of the README, pasted line by line into Python's interactive prompt
+    (where a loop needs a blank line after it), runs in a fresh namespace: it imports what it uses."""
     readme = (ROOT / "README.md").read_text()
     snippets = re.findall(r"```python\n(.*?)```", readme, flags=re.S)
     assert len(snippets) >= 2
-    for number, code in enumerate(snippets, 1):
-        try:
-            exec(compile(code, f"README.md python snippet {number}", "exec"), {})
-        except Exception as error:  # noqa: BLE001 - name the snippet that failed
-            raise AssertionError(f"README python snippet {number} fails: {error!r}") from error
+    for number, snippet in enumerate(snippets, 1):
+        console, shown = code.InteractiveConsole({}, filename=f"README.md python snippet {number}"), io.StringIO()
+        with contextlib.redirect_stderr(shown), contextlib.redirect_stdout(io.StringIO()):
+            waiting = False
+            for line in snippet.splitlines():
+                waiting = console.push(line)
+            if waiting:
+                console.push("")
+        assert "Traceback" not in shown.getvalue() and "Error" not in shown.getvalue(), \
+            f"README python snippet {number} fails at the prompt:\n{shown.getvalue()[-2000:]}"
 
 
 def test_every_console_script_starts_from_the_launcher_beside_the_packages():

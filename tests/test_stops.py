@@ -130,8 +130,8 @@ def test_play_ends_with_its_line_wherever_it_is_stopped_and_succeeds_once_done(t
                 assert command.stderr == "", command.stderr[-3000:]
             else:
                 assert command.shown_lines() == ["robostrich-play: interrupted"], command.stderr[-3000:]
-            assert sorted(p.name for p in out.iterdir()) == ["policy_heldout.json", "policy_track.json",
-                                                             "policy_track.png", "policy_track.rrd"]
+            assert sorted(p.name for p in out.iterdir()) == ["robostrich_heldout.json", "robostrich_track.json",
+                                                             "robostrich_track.png", "robostrich_track.rrd"]
         else:
             assert_stopped(command, 130, "interrupted")
             assert not list(out.glob("*.json")) and not list(out.glob(".*")), sorted(out.iterdir())

@@ -152,3 +152,29 @@ def test_web_with_no_recording_is_refused(tmp_path):
     assert refused.returncode == 2 and stdout == "", stderr[-3000:]
     assert stderr.splitlines() == ["robostrich-play: error: --web serves the .rrd recordings, which --no-rerun "
                                    "turns off: drop one of them"], stderr
+
+
+def test_a_killed_play_web_takes_its_server_with_it(tmp_path):
+    """SIGKILL runs no cleanup in the command, yet its rerun server ends with it (Linux's parent-death
+    signal), instead of listening on with no one left to stop it."""
+    port = _free_ports()
+    play = _play("--web", "--web-port", port, "--num-targets", 1, "--out", tmp_path / "play")
+    try:
+        _served_url(play)
+        play.kill()  # the command alone: its server is in the same process group, and must go by itself
+        play.wait(60)
+        deadline = time.monotonic() + 30
+        while any(_listening(p) for p in (port, port + 1)):
+            assert time.monotonic() < deadline, "the web viewer's server outlived the command"
+            time.sleep(0.2)
+    finally:
+        _end(play)
+        try:
+            os.killpg(play.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+
+
+def _listening(port: int) -> bool:
+    with socket.socket() as probe:
+        return probe.connect_ex(("127.0.0.1", port)) == 0

@@ -4,8 +4,10 @@ import shlex
 
 RUNS = {"curriculum": "curriculum SAC", "baseline": "plain SAC (final lesson only)", "lookup": "lookup (no learning)"}
 KINDS = {"heldout": "held-out, fixed start", "heldout_moving": "held-out, moving starts",
+         "new": "new targets, fixed start", "new_moving": "new targets, moving starts (one each)",
          "track": "`track` (3 targets in turn)"}
-SHORT_KINDS = {"heldout": "held-out, fixed start", "heldout_moving": "moving starts", "track": "`track`"}
+SHORT_KINDS = {"heldout": "held-out, fixed start", "heldout_moving": "moving starts", "new": "new targets",
+               "new_moving": "new, moving starts", "track": "`track`"}
 AFTER = "heldout_after_"  # the evaluation at the end of a lesson but the last
 
 
@@ -73,8 +75,8 @@ def per_seed(data: dict) -> tuple:
     """(what the cells are, each seed's cells): the curriculum's success in every evaluation it has
     (`track` as targets reached of 3) and the wall-clock of the whole job."""
     curriculum = data["results"].get("curriculum", {})
-    kinds = ["heldout", "heldout_moving"] + ["track"] * ("track" in curriculum) + sorted(
-        k for k in curriculum if k.startswith(AFTER))
+    kinds = (["heldout", "heldout_moving"] + [k for k in ("new", "new_moving") if k in curriculum]
+             + ["track"] * ("track" in curriculum) + sorted(k for k in curriculum if k.startswith(AFTER)))
     parts = []
     for i, seed in enumerate(data["seeds"]):
         cells = []
@@ -87,7 +89,8 @@ def per_seed(data: dict) -> tuple:
         minutes = data["minutes"][i]
         cells.append(f"{minutes:.1f} min" if minutes is not None else "time unknown")
         parts.append(f"seed {seed}: " + " / ".join(cells))
-    names = {"heldout": "held-out fixed", "heldout_moving": "moving", "track": "`track`"}
+    names = {"heldout": "held-out fixed", "heldout_moving": "moving", "new": "new fixed", "new_moving": "new moving",
+             "track": "`track`"}
     header = " / ".join([names.get(k, f"after {k[len(AFTER):]}") for k in kinds] + ["wall-clock of the whole job"])
     return header, "; ".join(parts)
 
@@ -113,20 +116,25 @@ def full(data: dict) -> list:
 
 def short(data: dict) -> list:
     """A block's rows: one per run, the success of each evaluation (of the lesson ends, the last)
-    and, from the fixed start, the precise share and the median errors; the page has every row."""
+    and, from the fixed start, the precise share (of held-out and, where measured, new targets) and
+    the median errors; the page has every row."""
     results, seeds = data["results"], len(data["seeds"])
     present = {kind for kinds in results.values() for kind in kinds}
     after = sorted(k for k in present if k.startswith(AFTER))[-1:]
     kinds = [k for k in SHORT_KINDS if k in present] + after
     titles = [SHORT_KINDS.get(k, f"after {k[len(AFTER):]}") for k in kinds]
-    lines = ["| run | " + " | ".join(titles) + " | within 1 cm and 2 deg | median error |",
-             "|---|" + "---|" * (len(kinds) + 2)]
+    new = "new" in present
+    lines = ["| run | " + " | ".join(titles) + " | within 1 cm and 2 deg |"
+             + " new, within 1 cm and 2 deg |" * new + " median error |",
+             "|---|" + "---|" * (len(kinds) + 2 + new)]
     for label, rows in results.items():
         partial = partial_seeds(rows.get("heldout", next(iter(rows.values()))), seeds)
         cells = [cell(rows[k]["success_rate"], 100, "%") if k in rows else "-" for k in kinds]
         fixed = rows.get("heldout")
-        cells += [cell(fixed["precise_success_rate"], 100, "%"),
-                  f"{fixed['position_error_median']['mean'] * 100:.2f} cm, "
-                  f"{fixed['attitude_error_median']['mean']:.2f} deg"] if fixed else ["-", "-"]
+        cells.append(cell(fixed["precise_success_rate"], 100, "%") if fixed else "-")
+        if new:
+            cells.append(cell(rows["new"]["precise_success_rate"], 100, "%") if "new" in rows else "-")
+        cells.append(f"{fixed['position_error_median']['mean'] * 100:.2f} cm, "
+                     f"{fixed['attitude_error_median']['mean']:.2f} deg" if fixed else "-")
         lines.append(f"| {RUNS.get(label, label)}{partial} | " + " | ".join(cells) + " |")
     return lines

@@ -24,6 +24,7 @@ import robostrich_suite
 from agents.robostrich.lookup import lookup_table, nearest
 from robostrich_suite import targets
 from robostrich_suite.model import layouts
+from robostrich_suite.studies import new_targets
 from robostrich_suite.tasks import options, quadruped_tasks, reach
 from robostrich_suite.tasks.track import default_track_targets
 
@@ -149,6 +150,16 @@ class Domain:
             return None
         pool = self._to_domain_frame(targets.heldout_targets(self._target_file()))
         return pool if num_targets is None else pool[spread_indices(len(pool), num_targets)]
+
+    def new_targets(self, count: int, seed: Optional[int] = None) -> Optional[np.ndarray]:
+        """``count`` level poses of this layout at least 1 cm from every pose of its target file,
+        made by the project's generator with a seed no target file uses (robostrich_suite/studies/
+        new_targets.py; made once, then cached), in this domain's frame; None off the arm."""
+        if not self.is_arm:
+            return None
+        made = new_targets.new_targets(self._target_file(), layouts.build(self.layout),
+                                       new_targets.SEED if seed is None else seed, count)
+        return self._to_domain_frame(made)
 
     def lookup_table(self) -> Optional[dict]:
         """The lookup baseline's stored poses for this layout (agents/robostrich/lookup.py), positions in this

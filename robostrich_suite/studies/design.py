@@ -99,6 +99,17 @@ def slot_range(text: str) -> tuple:
     return low, high
 
 
+MAX_STUDY_NAME = 200  # characters: Optuna's storages keep names of up to 512
+
+
+def study_name(text: str) -> str:
+    """argparse type for --study-name: a name with something to read in it, on one line."""
+    import argparse
+    if not text.strip() or len(text) > MAX_STUDY_NAME or not text.isprintable():
+        raise argparse.ArgumentTypeError(f"must be a printable name of 1 to {MAX_STUDY_NAME} characters, got {text!r}")
+    return text
+
+
 def build_parser() -> cli_lib.Parser:
     parser = cli_lib.Parser(prog=PROG, description=__doc__.splitlines()[0])
     parser.add_argument("--trials", type=cli_lib.whole_number(0, MAX_TRIALS), default=100,
@@ -109,7 +120,8 @@ def build_parser() -> cli_lib.Parser:
     parser.add_argument("--storage", default=None,
                         help="Optuna storage URL, e.g. sqlite:///study.db or postgresql://... for several "
                              "machines on one study (default: sqlite:///OUT/study.db)")
-    parser.add_argument("--study-name", default="robostrich-design", help="the study's name (default: %(default)s)")
+    parser.add_argument("--study-name", type=study_name, default="robostrich-design",
+                        help="the study's name (default: %(default)s)")
     parser.add_argument("--seed", type=cli_lib.seed, default=0,
                         help="the sampler's seed (offset by the trials already in the study) (default: %(default)s)")
     parser.add_argument("--pose-budget", type=cli_lib.whole_number(MIN_POSE_BUDGET, MAX_POSE_BUDGET), default=36,

@@ -88,8 +88,8 @@ def open_study(url: str, name: str, settings: Settings, seed: int):
         for key, value in settings.attrs().items():
             study.set_user_attr(key, value)
     elif Settings.of(study) != settings:
-        raise ValueError(f"study {name!r} was started with {Settings.of(study).flags()}: resume it with the "
-                         "same, or give another --study-name")
+        raise ValueError(f"study {name!r} was started with {Settings.of(study).flags()}, not {settings.flags()}: "
+                         "resume it with the same, or give another --study-name")
     study.sampler = sampler(seed + len(study.trials))
     return study
 

@@ -74,13 +74,18 @@ FIELDS = {
 
 def parse_scales(text: str) -> dict:
     """``FAMILY=S,...`` (``all=S`` for every family of the domain, named ones over it) as
-    {name: scale}; a ValueError naming the problem for an unknown family or a bad scale."""
+    {name: scale}; a ValueError naming the problem for an unknown or repeated family, an empty
+    item or a bad scale."""
     scales = {}
-    for item in filter(None, (part.strip() for part in text.split(","))):
+    for item in (part.strip() for part in text.split(",")):
+        if not item:
+            raise ValueError(f"an empty item in {text!r}: expected FAMILY=SCALE items separated by single commas")
         name, sep, value = item.partition("=")
         name = name.strip()
         if not sep or name not in FAMILIES + ("all",):
             raise ValueError(f"expected FAMILY=SCALE items with FAMILY one of all, {', '.join(FAMILIES)}; got {item!r}")
+        if name in scales:
+            raise ValueError(f"{name} is given twice in {text!r}: give each family once")
         try:
             scale = float(value)
         except ValueError:

@@ -127,14 +127,15 @@ def summarize(per_seed: list) -> dict:
 
 
 def evaluate(policies: list, seeds: int, gait, settle: float = SETTLE, record_dir: Optional[str] = None,
-             bar=None, **task_kwargs) -> dict:
+             bar=None, record_name: str = "stabilize_{label}.rrd", **task_kwargs) -> dict:
     """Every policy on `seeds` gait phases: per-seed metrics, summary, goals; the seed-0 series
-    (for the figure) and a Rerun recording of it per policy in `record_dir` (None: none)."""
+    (for the figure) and a Rerun recording of it per policy in `record_dir` (None: none), named
+    `record_name` with the policy's label."""
     import os
     report = {}
     for policy in policies:
         per_seed, first = [], None
-        recording = None if record_dir is None else os.path.join(record_dir, f"stabilize_{policy.label}.rrd")
+        recording = None if record_dir is None else os.path.join(record_dir, record_name.format(label=policy.label))
         for seed, env, series in applications.rollouts(policy, TASK, seeds, gait, lambda env: record, recording,
                                                        bar, **task_kwargs):
             per_seed.append({"seed": seed, **metrics(series, settle)})

@@ -1,9 +1,10 @@
 """Evaluation of the deterministic policy: held-out targets and the three-target `track` task (Fig. 7).
 
 On the arm every held-out target is tried from the fixed start (`heldout`) and
-from three poses where the arm holds another target (`heldout_moving`), and
-the no-learning `lookup` baseline (agents/robostrich/lookup.py) is evaluated beside the
-agents.  Other dm_control domains report episode returns.  Writes one JSON
+from three poses where the arm holds another target (`heldout_moving`); so are new targets, level
+poses at least 1 cm from every pose the agent trained on (`new`, `new_moving`: each new target from
+one of the three starts in turn; robostrich_suite/studies/new_targets.py), and the no-learning
+`lookup` baseline (agents/robostrich/lookup.py) is evaluated beside the agents.  Other dm_control domains report episode returns.  Writes one JSON
 report per evaluation. `main` (console command
 `robostrich-evaluate`) loads a checkpoint and writes the same reports,
 figures and Rerun recordings as the end of a training run; with `--web` it then serves the
@@ -33,10 +34,12 @@ from robostrich_suite import atomic_files, outputs, parsing, web_viewer
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import progress as progress_lib
 from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, PRECISE_POSITION_TOLERANCE
+from robostrich_suite.studies import new_targets as new_targets_lib
 from robostrich_suite.tasks.measurement import measure
 
 MAX_TARGETS = 10_000  # held-out targets (or seeded episodes off the arm) of one evaluation
 target_count = cli_lib.whole_number(1, MAX_TARGETS)  # argparse type of the target counts
+REPORT_KINDS = ("heldout", "heldout_moving", "new", "new_moving", "track")  # of evaluate_agent, in its order
 MAX_LABEL_BYTES = 100  # a label starts file names (LABEL_heldout_moving.json): well under a name's 255
 
 
@@ -174,7 +177,8 @@ def _names(domain) -> dict:
 
 
 def evaluate_heldout(actor, flattener, domain, task: str, num_targets: Optional[int] = None,
-                     seed: int = 10_000, targets=None, action_repeat: int = 1, on_episode=None) -> dict:
+                     seed: int = 10_000, targets=None, action_repeat: int = 1, on_episode=None,
+                     kind: str = "heldout") -> dict:
     """Deterministic policy, one episode per held-out target (a pool of that single target).
 
     Use a task with a fixed initial state (lesson2): every target then starts from the same pose.
@@ -197,7 +201,7 @@ def evaluate_heldout(actor, flattener, domain, task: str, num_targets: Optional[
         episodes.append(row)
         if on_episode:
             on_episode()
-    return {"kind": "heldout", **_names(domain), "task": task, "summary": summarize(episodes), "episodes": episodes}
+    return {"kind": kind, **_names(domain), "task": task, "summary": summarize(episodes), "episodes": episodes}
 
 
 def moving_starts(count: int = 3, domain="robostrich"):
@@ -208,13 +212,14 @@ def moving_starts(count: int = 3, domain="robostrich"):
 
 def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: Optional[int] = None,
                             seed: int = 30_000, targets=None, starts=None, action_repeat: int = 1,
-                            on_episode=None) -> dict:
+                            on_episode=None, kind: str = "heldout_moving", one_start_each: bool = False) -> dict:
     """Every held-out target from poses where the arm holds another target (lesson 3's situation).
 
     One lesson-3 environment: per start, an episode from the fixed pose holds
     the start's stored inputs (2 s: the arm comes to rest there); then, per
     held-out target, the task's `continue` initial state starts the evaluated
-    episode from that resting state. `starts` = (positions, controls).
+    episode from that resting state. `starts` = (positions, controls). With
+    ``one_start_each`` target i is tried from start i mod the number of starts only.
     """
     targets = heldout_targets(domain, num_targets) if targets is None else np.asarray(targets, np.float64)
     start_positions, start_controls = moving_starts(domain=domain) if starts is None else starts
@@ -222,7 +227,7 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
     episodes = []
     for k, (start, control) in enumerate(zip(start_positions, start_controls)):
         rest, held = _rest_at(env, start, control)
-        for target in targets:
+        for target in (targets[k::len(start_positions)] if one_start_each else targets):
             env.task.set_initial_state("continue")
             if rest is None:  # the hold diverged: from the fixed pose, as a diverged episode's successor
                 env.task.forget_last_state()
@@ -234,7 +239,7 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
             episodes.append(row)
             if on_episode:
                 on_episode()
-    return {"kind": "heldout_moving", **_names(domain), "task": MOVING_START_TASK, "summary": summarize(episodes),
+    return {"kind": kind, **_names(domain), "task": MOVING_START_TASK, "summary": summarize(episodes),
             "episodes": episodes}
 
 
@@ -268,15 +273,24 @@ def evaluate_track(actor, flattener, domain="robostrich", task: str = "track", s
 
 def evaluate_agent(actor, flattener, out_dir: str, label: str, domain, heldout_task: str,
                    track_task: Optional[str], num_targets: Optional[int] = None, env_steps: int = None,
-                   record: bool = True, action_repeat: int = 1, on_episode=None) -> dict:
-    """Held-out (+ from moving starts on the arm) + track evaluation, JSON reports and (optionally) a Rerun
+                   record: bool = True, action_repeat: int = 1, on_episode=None, new_targets=None) -> dict:
+    """Held-out (+ from moving starts on the arm), new-target (``new_targets``, (n, 2) in the
+    domain's frame, or None) and track evaluation, JSON reports and (optionally) a Rerun
     recording of the track rollout. ``on_episode()`` is called after each of its `episode_count` episodes."""
     os.makedirs(out_dir, exist_ok=True)
+    moving = as_domain(domain).has_moving_starts
     reports = {"heldout": evaluate_heldout(actor, flattener, domain, heldout_task, num_targets,
                                            action_repeat=action_repeat, on_episode=on_episode)}
-    if as_domain(domain).has_moving_starts:
+    if moving:
         reports["heldout_moving"] = evaluate_heldout_moving(actor, flattener, domain, num_targets,
                                                             action_repeat=action_repeat, on_episode=on_episode)
+    if new_targets is not None and len(new_targets):
+        reports["new"] = evaluate_heldout(actor, flattener, domain, heldout_task, targets=new_targets,
+                                          action_repeat=action_repeat, on_episode=on_episode, kind="new")
+        if moving:
+            reports["new_moving"] = evaluate_heldout_moving(actor, flattener, domain, targets=new_targets,
+                                                            action_repeat=action_repeat, on_episode=on_episode,
+                                                            kind="new_moving", one_start_each=True)
     if track_task:
         with open_recorder(os.path.join(out_dir, f"{label}_track.rrd") if record else None,
                            f"{label} track") as recorder:
@@ -290,13 +304,16 @@ def evaluate_agent(actor, flattener, out_dir: str, label: str, domain, heldout_t
     return reports
 
 
-def episode_count(domain, num_targets: Optional[int], track_task: Optional[str]) -> int:
+def episode_count(domain, num_targets: Optional[int], track_task: Optional[str], new_targets: int = 0) -> int:
     """Episodes of one `evaluate_agent` (for its progress bar): each held-out target from the fixed
-    start and, on the arm, from each moving start; one `track` episode."""
+    start and, on the arm, from each moving start; each of ``new_targets`` new targets from the
+    fixed start and from one moving start; one `track` episode."""
     domain = as_domain(domain)
     targets = heldout_targets(domain, num_targets)
     count = len(targets) if targets is not None else (num_targets or 10)
-    return count * (1 + (len(moving_starts(domain=domain)[0]) if domain.has_moving_starts else 0)) + bool(track_task)
+    moving = domain.has_moving_starts
+    return (count * (1 + (len(moving_starts(domain=domain)[0]) if moving else 0)) + new_targets * (1 + moving)
+            + bool(track_task))
 
 
 def outcome_text(kind: str, s: dict) -> str:
@@ -304,7 +321,7 @@ def outcome_text(kind: str, s: dict) -> str:
     2 deg, the median final errors and how many targets (episodes, from moving starts)."""
     return (f"{s['success_rate'] * 100:5.1f} % reached ({s['precise_success_rate'] * 100:.1f} % within 1 cm and "
             f"2 deg), median error {s['position_error_median'] * 100:.2f} cm, {s['attitude_error_median']:.2f} deg, "
-            f"{s['episodes']} {'targets' if kind != 'heldout_moving' else 'episodes'}")
+            f"{s['episodes']} {'episodes' if kind == 'heldout_moving' else 'targets'}")
 
 
 def summary_lines(runs: dict) -> list:
@@ -327,7 +344,7 @@ def summary_lines(runs: dict) -> list:
 def read_reports(out_dir: str, label: str) -> dict:
     """The reports `evaluate_agent` wrote for `label` (kind -> report), e.g. by a worker process."""
     reports = {}
-    for kind in ("heldout", "heldout_moving", "track"):
+    for kind in REPORT_KINDS:
         path = os.path.join(out_dir, f"{label}_{kind}.json")
         if os.path.exists(path):
             reports[kind] = parsing.read_json(path)  # a torn file is one ValueError naming it
@@ -335,7 +352,8 @@ def read_reports(out_dir: str, label: str) -> dict:
 
 
 def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optional[str],
-                    num_targets: Optional[int] = None, record: bool = True, on_episode=None) -> Optional[dict]:
+                    num_targets: Optional[int] = None, record: bool = True, on_episode=None,
+                    new_targets=None) -> Optional[dict]:
     """`evaluate_agent` for the lookup baseline (label `lookup`) on the arm; None on other domains.
 
     Action repeat 1: the lookup's input only changes with the target.
@@ -346,7 +364,7 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
     flattener = ObservationFlattener(make_environment(domain, heldout_task, 0).observation_spec())
     return evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain,
                           heldout_task, track_task, num_targets, env_steps=0, record=record, action_repeat=1,
-                          on_episode=on_episode)
+                          on_episode=on_episode, new_targets=new_targets)
 
 
 def write_json(path: str, obj) -> None:
@@ -371,6 +389,10 @@ def checked_fingerprint(path: str) -> dict:
                + [k for k in DomainRun.STATE_FIELDS if k not in record["payload"]])
     if missing:
         raise checkpoint.CheckpointError(f"{path} is not a whole robostrich-train checkpoint: it lacks {missing}")
+    try:
+        parse_plan(fp["plan"])
+    except (TypeError, ValueError) as error:
+        raise checkpoint.CheckpointError(f"{path} holds a damaged plan: {error}") from None
     return fp
 
 
@@ -394,6 +416,28 @@ def load_run_from_checkpoint(path: str):
     return run
 
 
+def add_new_target_flags(parser) -> None:
+    """--new-targets and --new-target-seed, as robostrich-evaluate and robostrich-train take them."""
+    parser.add_argument("--new-targets", type=cli_lib.whole_number(0, MAX_TARGETS), default=None,
+                        help="new targets on the arm: level poses at least 1 cm from every pose the agent trained "
+                             "on, made once per routing and seed, then cached (0: none; default: "
+                             f"{new_targets_lib.COUNT}, or as many as the held-out targets asked for where fewer)")
+    parser.add_argument("--new-target-seed", type=cli_lib.seed, default=new_targets_lib.SEED,
+                        help="seed of the new targets' first draw (default: %(default)s)")
+
+
+def new_targets_of(domain, args, heldout_count: Optional[int]) -> Optional[np.ndarray]:
+    """The new targets the flags ask for on ``domain`` (made now if not cached), None for none; by
+    default as many as ``heldout_count`` where that is fewer than the default count (a quick
+    evaluation stays quick)."""
+    domain = as_domain(domain)
+    count = args.new_targets if args.new_targets is not None else min(new_targets_lib.COUNT,
+                                                                        heldout_count or new_targets_lib.COUNT)
+    if not count or not domain.is_arm:
+        return None
+    return domain.new_targets(count, args.new_target_seed)
+
+
 def main(argv=None):
     parser = cli_lib.Parser(description="Evaluate a checkpoint (and, on the arm, the lookup baseline): "
                                                  "held-out targets and the track task.")
@@ -407,6 +451,7 @@ def main(argv=None):
                         help="task of the tracking evaluation; '' to skip it (default: %(default)s)")
     parser.add_argument("--num-targets", type=target_count, default=None,
                         help=f"held-out targets (default: all; at most {MAX_TARGETS})")
+    add_new_target_flags(parser)
     parser.add_argument("--no-rerun", action="store_true", help="no .rrd recordings")
     parser.add_argument("--no-figures", action="store_true", help="no PNG figures")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -422,18 +467,20 @@ def main(argv=None):
         raise ValueError("--web serves the track task's recordings, and this evaluation runs no track task")
     heldout_task = check_heldout_task(domain, args.heldout_task
                                       or default_heldout_task(domain, parse_plan(fingerprint["plan"])[-1].task))
+    new = new_targets_of(domain, args, args.num_targets)
     run = load_run_from_checkpoint(args.checkpoint)
     actor = SACBuilder.make_eval_actor(run.loop)
     labels = 2 if domain.is_arm else 1  # the lookup beside the agent on the arm
-    with progress_lib.bar(not args.quiet, total=labels * episode_count(domain, args.num_targets, track_task),
-                          desc="evaluation", unit="episode", dynamic_ncols=True) as bar:
+    total = labels * episode_count(domain, args.num_targets, track_task, 0 if new is None else len(new))
+    with progress_lib.bar(not args.quiet, total=total, desc="evaluation", unit="episode", dynamic_ncols=True) as bar:
         on_episode = bar.update if bar is not None else None
         reports = {args.label: evaluate_agent(actor, run.loop.flattener, out, args.label, domain, heldout_task,
                                               track_task or None, args.num_targets,
                                               env_steps=run.loop.env_steps, record=not args.no_rerun,
-                                              action_repeat=run.config.action_repeat, on_episode=on_episode)}
+                                              action_repeat=run.config.action_repeat, on_episode=on_episode,
+                                              new_targets=new)}
         lookup = evaluate_lookup(out, domain, heldout_task, track_task or None, args.num_targets,
-                                 not args.no_rerun, on_episode=on_episode)
+                                 not args.no_rerun, on_episode=on_episode, new_targets=new)
     if lookup is not None:
         reports["lookup"] = lookup
     if not args.no_figures and "track" in reports[args.label]:

@@ -46,9 +46,13 @@ class PerturbedDomain(Domain):
 
 
 def scale_list(text: str) -> tuple:
-    """argparse type of --scales: comma-separated scales from 0 to 1, sorted, without repeats."""
+    """argparse type of --scales: comma-separated scales from 0 to 1, sorted, without repeats; an
+    empty item (``0,,0.1``) is refused, not dropped."""
+    parts = [part.strip() for part in text.split(",")]
+    if not all(parts):
+        raise argparse.ArgumentTypeError(f"must be numbers separated by single commas, got {text!r} (an empty item)")
     try:
-        values = sorted({float(part) for part in text.split(",") if part.strip()})
+        values = sorted({float(part) for part in parts})
     except ValueError:
         raise argparse.ArgumentTypeError(f"must be numbers separated by commas, got {text!r}") from None
     if not values or any(not 0 <= v <= perturbations.MAX_SCALE for v in values):
@@ -164,8 +168,29 @@ def summary(args, evaluated_list, results, domain) -> dict:
         "families": list(families_of(domain)) + [ALL], "labels": [e.label for e in evaluated_list],
         "definitions": "robostrich_suite/tasks/perturbations.py",
         "results": results,
-        "falls_below": {family: thresholds(rows) for family, rows in results[main].items()},
+        "falls_below": {family: thresholds(rows) for family, rows in results[main].items()},  # the policy, fixed start
+        "falls_below_by_label": {label: {family: {kind: thresholds(rows, kind) for kind in KINDS if kind in rows[0]}
+                                         for family, rows in families.items()}
+                                 for label, families in results.items()},
     }
+
+
+KIND_WORDS = {"heldout": "fixed start", "heldout_moving": "moving starts"}
+
+
+def summary_lines(report: dict) -> list:
+    """Per policy (and the lookup) and family, where held-out success falls below 90 % and 80 %,
+    from the fixed start and from moving starts: what the figure shows, in words."""
+    lines = []
+    for label, families in report["falls_below_by_label"].items():
+        lines.append(f"{label}: held-out success, where it falls below 90 % / 80 % as the robot differs more")
+        for family, kinds in families.items():
+            parts = []
+            for kind, levels in kinds.items():
+                falls = ", ".join(f"below {float(k) * 100:.0f} % at s = {v}" for k, v in levels.items() if v is not None)
+                parts.append(f"{KIND_WORDS.get(kind, kind)}: {falls or 'above 90 % at every scale measured'}")
+            lines.append(f"  {family:14s} " + "; ".join(parts))
+    return lines
 
 
 def build_parser() -> cli_lib.Parser:
@@ -175,7 +200,7 @@ def build_parser() -> cli_lib.Parser:
                                         "increasing scale, then all at once. Writes robustness.json and .png.")
     parser.add_argument("policy", help=f"a shipped policy ({', '.join(policies.SHIPPED)}), a policy file (.npz) "
                                        "or a robostrich-train checkpoint (checkpoint.ckpt)")
-    parser.add_argument("--out", default="robostrich_robustness", help="directory for robustness.json and .png (default: %(default)s)")
+    parser.add_argument("--out", default="out/robustness", help="directory for robustness.json and .png (default: %(default)s)")
     parser.add_argument("--scales", type=scale_list, default=DEFAULT_SCALES,
                         help="scales s, comma-separated, 0 to 1 (default: %(default)s); what s means per family: "
                              "robostrich_suite/tasks/perturbations.py")
@@ -214,9 +239,7 @@ def main(argv=None) -> dict:
     report = summary(args, evaluated, results, domain)
     evaluation.write_json(os.path.join(args.out, "robustness.json"), report)
     robustness_figure.plot(report, os.path.join(args.out, "robustness.png"))
-    for family, levels in report["falls_below"].items():
-        line = ", ".join(f"below {float(k) * 100:.0f} % at s = {v}" for k, v in levels.items() if v is not None)
-        print(f"{family:14s} {line or 'above 90 % at every scale measured'}", flush=True)
+    print("\n".join(summary_lines(report)), flush=True)
     print(f"wrote {args.out}/robustness.json, robustness.png", flush=True)
     return report
 

@@ -11,7 +11,7 @@ import shlex
 from robostrich_suite import parsing
 
 LABELS = ("curriculum", "baseline", "lookup")
-KINDS = ("heldout", "heldout_moving", "track")
+KINDS = ("heldout", "heldout_moving", "new", "new_moving", "track")
 METRICS = (("success_rate", "success rate (%)", 100.0, "{:.1f}"),
            ("precise_success_rate", "success within 1 cm and 2 deg (%)", 100.0, "{:.1f}"),
            ("position_error_median", "median position error (m)", 1.0, "{:.3f}"),
@@ -104,15 +104,18 @@ def _join(values):
 # The sweep's columns: (evaluation, metric, scale, format); the last column is the training time.
 GROUP_COLUMNS = (("success, fixed start", "heldout", "success_rate", 100.0, "{:.1f} %"),
                  ("moving starts", "heldout_moving", "success_rate", 100.0, "{:.1f} %"),
+                 ("new targets, fixed start", "new", "success_rate", 100.0, "{:.1f} %"),
+                 ("new targets, moving starts", "new_moving", "success_rate", 100.0, "{:.1f} %"),
                  ("`track`", "track", "success_rate", 100.0, "{:.1f} %"),
                  ("within 1 cm and 2 deg", "heldout", "precise_success_rate", 100.0, "{:.1f} %"),
+                 ("new targets within 1 cm and 2 deg", "new", "precise_success_rate", 100.0, "{:.1f} %"),
                  ("median position error", "heldout", "position_error_median", 100.0, "{:.2f} cm"),
                  ("median attitude error", "heldout", "attitude_error_median", 1.0, "{:.2f} deg"))
 
 
 def group_table(agg: dict, minutes: dict) -> list:
     """Markdown rows of one group: curriculum, plain SAC and lookup (the ones it has), each with its
-    success from the fixed and the moving starts, on `track`, the precise share, the median errors
+    success from the fixed and the moving starts (held-out and new targets), on `track`, the precise share, the median errors
     (fixed start) and its training minutes, mean [min, max] over the group's seeds."""
     lines = ["| run | " + " | ".join(c[0] for c in GROUP_COLUMNS) + " | minutes |",
              "|---|" + "---|" * (len(GROUP_COLUMNS) + 1)]

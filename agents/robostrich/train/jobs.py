@@ -37,6 +37,7 @@ class RunJob:
     final_eval_targets: Optional[int]
     out_eval: str
     record: bool
+    new_targets: Optional[np.ndarray] = None  # of the final evaluation, made by the parent (domains.Domain.new_targets)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -91,7 +92,8 @@ class LookupSpec:
     def evaluate(self, job: RunJob, progress=None) -> Optional[dict]:
         return evaluation.evaluate_lookup(job.out_eval, job.domain, job.heldout_task, job.track_task,
                                           job.final_eval_targets, record=job.record,
-                                          on_episode=progress.evaluated if progress is not None else None)
+                                          on_episode=progress.evaluated if progress is not None else None,
+                                          new_targets=job.new_targets)
 
 
 def final_targets(job: RunJob) -> Optional[int]:
@@ -132,7 +134,8 @@ def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
                                         run.name, job.domain, job.heldout_task, job.track_task, final_targets(job),
                                         env_steps=run.loop.env_steps, record=job.record,
                                         action_repeat=config.action_repeat,
-                                        on_episode=progress.evaluated if progress is not None else None)
+                                        on_episode=progress.evaluated if progress is not None else None,
+                                        new_targets=job.new_targets)
     return {"reports": reports, "env_steps": run.loop.env_steps, "updates": run.loop.learner.num_updates,
             "timing": timing}
 
