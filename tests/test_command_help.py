@@ -134,3 +134,23 @@ def test_help_answers_before_any_heavy_import():
     installed = subprocess.run([conftest.console_script("robostrich-train"), "--help"], capture_output=True, text=True,
                                timeout=120)
     assert installed.returncode == 0 and installed.stdout.startswith("usage: robostrich-train "), installed.stderr
+
+
+def test_one_name_per_idea_across_commands():
+    """Every command turns off its progress bar with --no-progress and its .rrd recordings with
+    --no-rerun (the older --quiet, --no-rrd and --no-recording stay as aliases)."""
+    import robostrich_commands
+    named = {}
+    for prog in COMMANDS:
+        lines = open(robostrich_commands.help_path(prog), encoding="utf-8").read().splitlines()
+        for i, line in enumerate(lines):
+            match = FLAG.match(line)
+            if not match or not match.group(2).startswith("--no-"):
+                continue
+            text, k = line, i + 1
+            while k < len(lines) and lines[k].startswith(" " * 10) and not FLAG.match(lines[k]):
+                text, k = text + " " + lines[k].strip(), k + 1
+            for idea, name in (("progress bar", "--no-progress"), (".rrd", "--no-rerun")):
+                if idea in text:
+                    named.setdefault(idea, set()).add(match.group(2))
+    assert named == {"progress bar": {"--no-progress"}, ".rrd": {"--no-rerun"}}, named

@@ -97,3 +97,19 @@ def test_options_as_json_gives_them_are_accepted():
         random=0, trunk_heights={"times": [0.0, 1.0], "heights": [0.27, 0.22]}, steer=False))
     assert quadruped.task.steer is False
     np.testing.assert_allclose(quadruped.task._trunk_heights(1.0), 0.22)
+
+
+def test_target_jitter_moves_each_drawn_target_within_its_radius_and_off_it_draws_the_pool_itself():
+    pool = np.array([[0.3, 0.2], [0.1, 0.5]])
+    drawn = {}
+    for jitter in (0.0, 0.02):
+        env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=3, target_pool=pool,
+                                                                              target_jitter=jitter))
+        drawn[jitter] = []
+        for _ in range(40):
+            env.reset()
+            drawn[jitter].append(env.task.target_position.copy())
+    off = np.min(np.linalg.norm(np.array(drawn[0.0])[:, None] - pool[None], axis=2), axis=1)
+    assert np.all(off == 0.0)
+    moved = np.min(np.linalg.norm(np.array(drawn[0.02])[:, None] - pool[None], axis=2), axis=1)
+    assert np.all(moved <= 0.02) and np.all(moved > 0) and moved.max() > 0.015  # spread over the disk

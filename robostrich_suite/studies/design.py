@@ -149,7 +149,8 @@ def build_parser() -> cli_lib.Parser:
     parser.add_argument("--confirm", type=cli_lib.whole_number(0, 50), default=0, metavar="K",
                         help="full measures of the front's best K routings (by gap column, then coverage; "
                              "default: %(default)s)")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar, only the summary")
+    parser.add_argument("--no-progress", "--quiet", dest="quiet", action="store_true",
+                        help="no progress bar, only the summary")
     return parser
 
 

@@ -413,7 +413,7 @@ def build_parser() -> cli_lib.Parser:
                         help="also settle N random ventral inputs at the held dorsal length and "
                              "print how tightly the attitude follows the head position "
                              "(about 0.1 s each; default: %(default)s)")
-    parser.add_argument("--no-recording", action="store_true", help="skip the .rrd files")
+    parser.add_argument("--no-rerun", "--no-recording", dest="no_recording", action="store_true", help="no .rrd recordings")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     return parser
 

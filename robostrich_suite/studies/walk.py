@@ -168,7 +168,7 @@ def main(argv=None) -> None:
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/walk"),
                         help="output directory: writes OUT/walk.rrd and OUT/walk.png "
                              "(default: %(default)s)")
-    parser.add_argument("--no-rrd", action="store_true", help="skip the Rerun recording")
+    parser.add_argument("--no-rerun", "--no-rrd", dest="no_rrd", action="store_true", help="no .rrd recording")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--seed", type=cli_lib.seed, default=0,
                         help="random seed of the episode (default: %(default)s)")

@@ -71,6 +71,8 @@ class ReachConfig:
     in the observation, which the arm's state alone does not show. hindsight_level_goals: an
     agent's hindsight goals (agents/goals.py) only from reached poses whose head was level (within
     the attitude tolerance), goals eq. 10's lessons could set (:meth:`Reach.settable_goals`).
+    target_jitter: each drawn target moved by up to this distance (m), uniformly over a disk in the
+    targets' plane, so that training meets the poses between the pool's, not the list alone (0: off).
     """
     reward: str = "lesson2"
     initial_state: str = "fixed"
@@ -90,9 +92,11 @@ class ReachConfig:
     perturbation: object = None
     observe_sent_actions: int = 0
     hindsight_level_goals: bool = False
+    target_jitter: float = 0.0
 
 
 MAX_SENT_ACTIONS = 8  # control steps of sent actions an observation may hold
+MAX_TARGET_JITTER = 0.05  # m: well inside the spacing of the workspace's far ends
 
 
 def default_config() -> ReachConfig:
@@ -134,6 +138,8 @@ class Reach(base.Task):
         self.observe_sent_actions = options.whole("observe_sent_actions", config.observe_sent_actions, 0,
                                                   MAX_SENT_ACTIONS, "a whole number of control steps")
         self.hindsight_level_goals = options.flag("hindsight_level_goals", config.hindsight_level_goals)
+        self.target_jitter = options.number("target_jitter", config.target_jitter, 0.0, MAX_TARGET_JITTER,
+                                            f"a distance from 0 to {MAX_TARGET_JITTER:g} m")
         self._sent_actions = None  # (observe_sent_actions, tendons), newest first, see before_step
         self._robot_ready = False  # see _begin_robot
         self.target_position = self.target_pool[0].copy()
@@ -256,7 +262,12 @@ class Reach(base.Task):
         self._continues_from_physics = False
 
     def next_target(self) -> np.ndarray:
-        return self.sampler.draw(self.random, self.initial_state)
+        target = self.sampler.draw(self.random, self.initial_state)
+        if self.target_jitter:  # uniform over the disk: the radius as the square root of a uniform draw
+            radius = self.target_jitter * np.sqrt(self.random.uniform())
+            angle = self.random.uniform(0.0, 2.0 * np.pi)
+            target = target + radius * np.array([np.cos(angle), np.sin(angle)])
+        return target
 
     # --- checkpoints ----------------------------------------------------------
     def checkpoint_state(self) -> dict:

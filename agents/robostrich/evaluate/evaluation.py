@@ -454,7 +454,7 @@ def main(argv=None):
     add_new_target_flags(parser)
     parser.add_argument("--no-rerun", action="store_true", help="no .rrd recordings")
     parser.add_argument("--no-figures", action="store_true", help="no PNG figures")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--no-progress", "--quiet", dest="quiet", action="store_true", help="no progress bar")
     web_viewer.add_flags(parser)
     args = parser.parse_args(argv)
     out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.checkpoint)), "evaluation")

@@ -60,7 +60,7 @@ def build_parser():
                         "installed and see --out at the same path (default: a local Ray, started and stopped here)")
     p.add_argument("--num-cpus", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS), default=None,
                    help="CPUs of the local Ray, one run each (default: every core)")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-progress", "--quiet", dest="quiet", action="store_true", help="no progress bar")
     return p
 
 

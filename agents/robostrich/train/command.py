@@ -118,7 +118,7 @@ def _add_report_arguments(report) -> None:
                         help="task of the final tracking evaluation; '' to skip it (default: %(default)s)")
     report.add_argument("--no-rerun", action="store_true", help="no .rrd recordings of the final evaluation")
     report.add_argument("--no-figures", action="store_true", help="no PNG figures")
-    report.add_argument("--quiet", action="store_true", help="no progress bar")
+    report.add_argument("--no-progress", "--quiet", dest="quiet", action="store_true", help="no progress bar")
 
 
 def build_parser():
