@@ -85,12 +85,15 @@ JAX_CACHE_SETTINGS = {  # a size limit turns on JAX's file lock, which both xdis
 @pytest.fixture(scope="session", autouse=True)
 def shared_jax_cache(tmp_path_factory):
     """One XLA cache for the test run, shared by both xdist workers, the commands they start and
-    the tests' own processes: compiling the learner's update is most of a tiny training's work."""
+    the tests' own processes: compiling the learner's update is most of a tiny training's work; and
+    one cache of the project's (ROBOSTRICH_CACHE) in the run's temporary folder."""
     base = tmp_path_factory.getbasetemp()
     cache = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "jax_cache"
     cache.mkdir(exist_ok=True)
     settings = {"jax_compilation_cache_dir": str(cache), **JAX_CACHE_SETTINGS}
     variables = {name.upper(): str(value) for name, value in settings.items()}
+    # the project's own cache (new targets made, the lookup's evaluations) for the run, not the user's home
+    variables["ROBOSTRICH_CACHE"] = str(cache.parent / "robostrich_cache")
     os.environ.update(variables)
     COMMAND_ENVIRONMENT.update(variables)
     import jax

@@ -192,3 +192,25 @@ def test_continued_episode_keeps_the_servo_command():
         timestep = env.step(held)
     env.reset()
     np.testing.assert_allclose(env.physics.arm_control(), held)
+
+
+def test_the_lookups_evaluation_is_kept_and_copied_until_what_it_depends_on_changes(tmp_path, monkeypatch):
+    """The same evaluation of the lookup (routing, targets, tasks, code) is copied from the cache,
+    file for file, instead of being made again; other new targets make it again."""
+    monkeypatch.setenv("ROBOSTRICH_CACHE", str(tmp_path / "cache"))
+    domain = evaluation.as_domain("robostrich")
+    new = domain.new_targets(2)
+    made = evaluation.evaluate_lookup(str(tmp_path / "a"), domain, "lesson2", None, 1, record=False, new_targets=new)
+    assert set(made) == {"heldout", "heldout_moving", "new", "new_moving"}
+
+    def evaluated_again(*args, **kwargs):
+        raise AssertionError("the lookup was evaluated again")
+    monkeypatch.setattr(evaluation, "evaluate_agent", evaluated_again)
+    ticks = []
+    copied = evaluation.evaluate_lookup(str(tmp_path / "b"), domain, "lesson2", None, 1, record=False,
+                                        new_targets=new, on_episode=lambda: ticks.append(1))
+    assert json.loads(json.dumps(made)) == copied
+    assert sorted(os.listdir(tmp_path / "b")) == sorted(os.listdir(tmp_path / "a"))
+    assert len(ticks) == evaluation.episode_count(domain, 1, None, 2)  # the progress bar still fills
+    with pytest.raises(AssertionError, match="evaluated again"):
+        evaluation.evaluate_lookup(str(tmp_path / "c"), domain, "lesson2", None, 1, record=False, new_targets=new[:1])

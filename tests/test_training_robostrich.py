@@ -63,8 +63,10 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
     summary = json.load(open(os.path.join(out, "summary.json")))["runs"]
     assert set(summary) == {"curriculum", "baseline", "lookup"}  # the no-learning bar beside the agents
     for label in summary:
-        assert set(summary[label]) == {"heldout", "heldout_moving", "track"}
+        assert set(summary[label]) == {"heldout", "heldout_moving", "new", "new_moving", "track"}
         assert summary[label]["heldout_moving"]["episodes"] == 2 * 3  # each held-out target from three starts
+        # as many new targets as held-out ones asked for, each from the fixed start and from one moving start
+        assert summary[label]["new"]["episodes"] == summary[label]["new_moving"]["episodes"] == 2
     assert summary["lookup"]["heldout"]["success_rate"] == 1.0  # the first two held-out targets
     evals = [json.loads(l) for l in open(os.path.join(out, "curriculum", "evals.jsonl"))]
     assert [e["env_steps"] for e in evals] == [125, 250, 375, 500, 625, 750]

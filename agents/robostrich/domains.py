@@ -97,7 +97,8 @@ class Domain:
         return self.name == "robostrich_a1"
 
     # -- environments ------------------------------------------------------------------------
-    def _target_file(self):
+    def target_file(self):
+        """The layout's level-pose target file: its training, held-out and new targets, its lookup table."""
         return layouts.target_file(self.layout)
 
     def _to_domain_frame(self, frame_targets) -> np.ndarray:
@@ -115,7 +116,7 @@ class Domain:
         if task == TRACK_TASK:
             kwargs["targets"] = default_track_targets(self.heldout_targets())
         elif task.startswith("lesson"):  # head_stabilize and narrow_gap have their own targets
-            kwargs["target_pool"] = self._to_domain_frame(targets.training_targets(self._target_file()))
+            kwargs["target_pool"] = self._to_domain_frame(targets.training_targets(self.target_file()))
         return kwargs
 
     def make_environment(self, task: str, seed: int, **task_kwargs):
@@ -148,7 +149,7 @@ class Domain:
         """The layout's held-out targets in this domain's frame; None (seeded episodes) off the arm."""
         if not self.is_arm:
             return None
-        pool = self._to_domain_frame(targets.heldout_targets(self._target_file()))
+        pool = self._to_domain_frame(targets.heldout_targets(self.target_file()))
         return pool if num_targets is None else pool[spread_indices(len(pool), num_targets)]
 
     def new_targets(self, count: int, seed: Optional[int] = None) -> Optional[np.ndarray]:
@@ -157,7 +158,7 @@ class Domain:
         new_targets.py; made once, then cached), in this domain's frame; None off the arm."""
         if not self.is_arm:
             return None
-        made = new_targets.new_targets(self._target_file(), layouts.build(self.layout),
+        made = new_targets.new_targets(self.target_file(), layouts.build(self.layout),
                                        new_targets.SEED if seed is None else seed, count)
         return self._to_domain_frame(made)
 
@@ -166,7 +167,7 @@ class Domain:
         domain's frame; None off the arm."""
         if not self.is_arm:
             return None
-        path = self._target_file()
+        path = self.target_file()
         table = lookup_table(targets.level_head_poses(path), targets.heldout_targets(path))
         table["head_position"] = self._to_domain_frame(table["head_position"])
         return table
@@ -176,7 +177,7 @@ class Domain:
         picks its targets) and the stored inputs that hold them (never a held-out pose)."""
         table = self.lookup_table()
         starts = default_track_targets(
-            self._to_domain_frame(targets.training_targets(self._target_file())), count)
+            self._to_domain_frame(targets.training_targets(self.target_file())), count)
         return starts, np.stack([table["control"][nearest(table, s)] for s in starts])
 
     def stored_start_inputs(self, exclusion: float = 0.02) -> np.ndarray:

@@ -26,6 +26,7 @@ from agents.robostrich import figures
 from agents.robostrich.domains import as_domain, domain_of, MOVING_START_TASK, TRACK_TASK
 from agents.robostrich.lookup import LABEL, LookupPolicy
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
+from agents.robostrich.evaluate import lookup_cache
 from agents.robostrich.recording import open_recorder
 from agents.robostrich.domain_run import DomainRun, current_fingerprint, make_environment, parse_plan
 from agents.sac.builder import SACBuilder
@@ -355,16 +356,31 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
                     num_targets: Optional[int] = None, record: bool = True, on_episode=None,
                     new_targets=None) -> Optional[dict]:
     """`evaluate_agent` for the lookup baseline (label `lookup`) on the arm; None on other domains.
+    The same evaluation made before (the same routing, targets, tasks and code) is copied from its
+    cache instead (agents/robostrich/evaluate/lookup_cache.py).
 
     Action repeat 1: the lookup's input only changes with the target.
     """
     domain = as_domain(domain)
     if not domain.is_arm:
         return None
+    digest = lookup_cache.key(domain, heldout_task, track_task, num_targets, new_targets, record,
+                              domain.target_file())
+    restored = lookup_cache.restore(digest, out_dir)
+    if restored is not None:
+        if on_episode:
+            for _ in range(episode_count(domain, num_targets, track_task,
+                                         0 if new_targets is None else len(new_targets))):
+                on_episode()
+        return {name[len(LABEL) + 1:-len(".json")]: parsing.read_json(os.path.join(out_dir, name))
+                for name in restored if name.endswith(".json")}
     flattener = ObservationFlattener(make_environment(domain, heldout_task, 0).observation_spec())
-    return evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain,
-                          heldout_task, track_task, num_targets, env_steps=0, record=record, action_repeat=1,
-                          on_episode=on_episode, new_targets=new_targets)
+    reports = evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain,
+                             heldout_task, track_task, num_targets, env_steps=0, record=record, action_repeat=1,
+                             on_episode=on_episode, new_targets=new_targets)
+    lookup_cache.keep(digest, out_dir, [f"{LABEL}_{kind}.json" for kind in reports]
+                      + ([f"{LABEL}_track.rrd"] if record and "track" in reports else []))
+    return reports
 
 
 def write_json(path: str, obj) -> None:
