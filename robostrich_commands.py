@@ -24,7 +24,7 @@ TERMINATED = 143
 
 COMMANDS = {
     "robostrich-train": "agents.robostrich.train.command:cli",
-    "robostrich-evaluate": "agents.robostrich.evaluate.evaluation:cli",
+    "robostrich-evaluate": "agents.robostrich.evaluate.command:cli",
     "robostrich-layouts": "agents.robostrich.layout_comparison:cli",
     "robostrich-stabilize": "agents.robostrich.applications.commands:stabilize_cli",
     "robostrich-gap": "agents.robostrich.applications.commands:gap_cli",

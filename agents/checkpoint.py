@@ -14,13 +14,12 @@ import hashlib
 import io
 import json
 import os
+import stat
 import struct
 import tempfile
 import zipfile
 
 import numpy as np
-
-from robostrich_suite import input_files
 
 MAGIC = b"RSACKPTZ"
 # The magic of the pickled checkpoints of format versions 1-2, refused without being unpickled.
@@ -169,6 +168,24 @@ class _Arrays(dict):
         return array
 
 
+def _read_regular_file(path: str) -> bytes:
+    """The file's bytes, if it is a regular file of at most MAX_CHECKPOINT_BYTES: opened without
+    waiting, so a FIFO is refused instead of waited on, and a device such as /dev/zero is refused
+    instead of read without end (CheckpointError naming it)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    with os.fdopen(fd, "rb") as handle:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise CheckpointError(f"{path} is not a regular file (a FIFO, a device or a directory), not a checkpoint")
+        if info.st_size > MAX_CHECKPOINT_BYTES:
+            raise CheckpointError(f"{path} holds {info.st_size} bytes, more than a checkpoint may ({MAX_CHECKPOINT_BYTES})")
+        os.set_blocking(fd, True)
+        data = handle.read(MAX_CHECKPOINT_BYTES + 1)
+    if len(data) > MAX_CHECKPOINT_BYTES:
+        raise CheckpointError(f"{path} holds more than a checkpoint may ({MAX_CHECKPOINT_BYTES} bytes)")
+    return data
+
+
 def _read_record(path: str) -> dict:
     """The stored record after checking header, checksum, layout and format version; CheckpointError if not."""
     return read_with_digest(path)[0]
@@ -177,10 +194,7 @@ def _read_record(path: str) -> dict:
 def read_with_digest(path: str) -> tuple:
     """(record, hex sha256 of its content) after the checks of :func:`_read_record`: the digest names
     this checkpoint's content (a run started from it records it)."""
-    try:
-        data = input_files.read_bytes(path, MAX_CHECKPOINT_BYTES, "checkpoint")
-    except ValueError as error:
-        raise CheckpointError(str(error)) from None
+    data = _read_regular_file(path)
     if data[:len(PICKLE_MAGIC)] == PICKLE_MAGIC:
         raise CheckpointError(f"{path} is a checkpoint of format version 2 or earlier, written with pickle, which "
                               f"this version does not read (loading a pickle can run code); train it again, or "
@@ -220,7 +234,6 @@ def _parse(content: memoryview) -> dict:
     if not zipfile.is_zipfile(body):  # numpy would read anything else as one array, or a pickle it refuses
         raise ValueError("the body is not an .npz archive")
     body.seek(0)
-    input_files.check_npz(body, "its body", MAX_CHECKPOINT_BYTES)
     with np.load(body, allow_pickle=False) as archive:
         arrays = _Arrays(archive)
         return {"format_version": FORMAT_VERSION, "fingerprint": _decode(header.get("fingerprint"), arrays),

@@ -136,4 +136,5 @@ def test_commands_given_a_fifo_or_a_device_answer_at_once_in_one_line(tmp_path):
         name, args = commands[case]
         lines = result.stderr.strip().splitlines()
         assert result.returncode == 2 and len(lines) == 1, (case, result.stderr[-3000:])
-        assert lines[0].startswith(f"{name}: error: {args[1 if name == 'robostrich-play' else 0]}: "), lines[0]
+        assert lines[0].startswith(f"{name}: error: {args[1 if name == 'robostrich-play' else 0]}"), lines[0]
+        assert "regular file" in lines[0], lines[0]

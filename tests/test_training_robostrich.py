@@ -5,6 +5,7 @@ import os
 import numpy as np
 import pytest
 
+from agents.robostrich.evaluate import command as evaluate_command
 from agents.robostrich.evaluate import evaluation
 from agents.robostrich.domain_run import DomainRun, parse_plan
 from agents.sac.builder import SACBuilder
@@ -85,7 +86,7 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
                                        "target_sampling": "failures", "fixed_stored_starts": 0.25}
     assert recorded["lessons"]["her_lessons"] == ["lesson1"]
     assert recorded["config"]["her_ratio"] == 0.5 and "her_level_goals" not in recorded["config"]
-    reports = evaluation.main([os.path.join(out, "curriculum", "checkpoint.ckpt"), "--out", str(tmp_path / "ev"),
+    reports = evaluate_command.main([os.path.join(out, "curriculum", "checkpoint.ckpt"), "--out", str(tmp_path / "ev"),
                                "--num-targets", "2", "--no-rerun", "--label", "curriculum"])
     for label in ("curriculum", "lookup"):  # deterministic policies, same targets
         assert {k: r["summary"] for k, r in reports[label].items()} == summary[label]

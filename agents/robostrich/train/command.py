@@ -20,6 +20,7 @@ import sys
 from agents import config_flags
 from agents.curriculum import format_plan, run_files
 from agents.robostrich import figures, recording
+from agents.robostrich.evaluate import command as evaluate_command
 from agents.robostrich.evaluate import evaluation
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.robostrich.train.main_job import (DEFAULT_ARM_LAYOUT, DEFAULT_ARM_TASK_KWARGS, DEFAULT_TOTAL_STEPS,
@@ -110,7 +111,7 @@ def _add_report_arguments(report) -> None:
                              "default: %(default)s)")
     report.add_argument("--final-eval-targets", type=evaluation.target_count, default=None,
                         help="held-out targets in the final evaluation (default: all)")
-    evaluation.add_new_target_flags(report)
+    evaluate_command.add_new_target_flags(report)
     report.add_argument("--heldout-task", default=None,
                         help="task for held-out evaluation (default: lesson2 on robostrich, i.e. eq. 10 from the "
                              "fixed initial pose; else the final lesson)")
@@ -206,7 +207,7 @@ def train_all(args, setup: TrainingSetup, specs: dict, runs: dict):
     job = RunJob(domain=setup.domain, heldout_task=setup.heldout_task, track_task=setup.track_task,
                  eval_at=tuple(eval_at), num_eval_targets=args.num_eval_targets,
                  final_eval_targets=args.final_eval_targets, out_eval=os.path.join(args.out, "evaluation"),
-                 record=not args.no_rerun, new_targets=evaluation.new_targets_of(setup.domain, args, args.final_eval_targets))
+                 record=not args.no_rerun, new_targets=evaluate_command.new_targets_of(setup.domain, args, args.final_eval_targets))
     episodes = evaluation.episode_count(setup.domain, final_targets(job), setup.track_task,
                                         0 if job.new_targets is None else len(job.new_targets))
     progress = Progress(sum(spec.total_steps for spec in specs.values()), enabled=not args.quiet,
