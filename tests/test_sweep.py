@@ -97,6 +97,13 @@ def test_the_group_table_has_a_row_per_run_and_mean_min_max_over_seeds():
                        "1.00 cm | 1.00 deg | 15.0 [10.0, 20.0] |")
     assert rows[3] == "| plain SAC | 25.0 % | - | - | 50.0 % | 3.00 cm | 2.00 deg | 1.0 |"
     assert rows[4] == "| lookup | 90.0 % | 80.0 % | - | 0.0 % | 1.00 cm | 1.00 deg | - |"
+    summaries[0]["runs"]["curriculum"].update(new=_report(0.75, precise=0.5), new_moving=_report(0.5))
+    newer = sweep_table.group_table(sweep_table.aggregate(summaries[:1], [0], [11.0]),
+                                    sweep_table.training_minutes(summaries[:1]))
+    assert newer[0] == ("| run | success, fixed start | moving starts | new targets, fixed start | new targets, moving "
+                        "starts | `track` | within 1 cm and 2 deg | new targets within 1 cm and 2 deg | median position "
+                        "error | median attitude error | minutes |")
+    assert newer[2].startswith("| curriculum SAC | 100.0 % | 50.0 % | 75.0 % | 50.0 % | 66.7 % | 50.0 % | 50.0 % |")
 
 
 # -- the command (real runs on a local Ray) -------------------------------------------------------

@@ -116,14 +116,17 @@ GROUP_COLUMNS = (("success, fixed start", "heldout", "success_rate", 100.0, "{:.
 def group_table(agg: dict, minutes: dict) -> list:
     """Markdown rows of one group: curriculum, plain SAC and lookup (the ones it has), each with its
     success from the fixed and the moving starts (held-out and new targets), on `track`, the precise share, the median errors
-    (fixed start) and its training minutes, mean [min, max] over the group's seeds."""
-    lines = ["| run | " + " | ".join(c[0] for c in GROUP_COLUMNS) + " | minutes |",
-             "|---|" + "---|" * (len(GROUP_COLUMNS) + 1)]
+    (fixed start) and its training minutes, mean [min, max] over the group's seeds; an evaluation
+    no run has (the new targets of runs made before them) gets no column."""
+    present = {kind for kinds in agg["results"].values() for kind in kinds}
+    columns = [c for c in GROUP_COLUMNS if c[1] in present or c[1] == "heldout"]  # no column no run has
+    lines = ["| run | " + " | ".join(c[0] for c in columns) + " | minutes |",
+             "|---|" + "---|" * (len(columns) + 1)]
     seeds = len(agg["seeds"])
     for label, kinds in agg["results"].items():
         counted = kinds.get("heldout", {}).get("seeds", seeds)
         partial = f" ({counted} of {seeds} seeds)" if counted != seeds else ""
-        cells = [_spread(kinds.get(kind, {}).get(metric), scale, fmt) for _, kind, metric, scale, fmt in GROUP_COLUMNS]
+        cells = [_spread(kinds.get(kind, {}).get(metric), scale, fmt) for _, kind, metric, scale, fmt in columns]
         cells.append(_spread(minutes.get(label), 1.0, "{:.1f}"))
         lines.append(f"| {RUN_TITLES.get(label, label)}{partial} | " + " | ".join(cells) + " |")
     return lines
