@@ -8,7 +8,8 @@ each kept at least ``targets.MIN_TARGET_SPACING`` (1 cm) from every pose of the 
 file and from each other. Draws come in fixed chunks of their own seeds, so a set depends on the
 seed alone, not on how many processes drew it, and a smaller set is the start of a larger one. A
 set is made once per routing and seed and read from a cache after that (the default routing's ships
-in ``robostrich_suite/data/new_targets/``); a larger count than the cache holds draws on.
+in ``robostrich_suite/data/new_targets/``); a larger count than it holds is made anew from the
+first draw, and starts with the smaller set.
 """
 from __future__ import annotations
 
