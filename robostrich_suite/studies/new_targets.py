@@ -19,7 +19,7 @@ import pathlib
 
 import numpy as np
 
-from robostrich_suite import atomic_files, parallel, targets
+from robostrich_suite import parallel, targets
 from robostrich_suite import progress as progress_lib
 from robostrich_suite.studies import target_generation, workspace
 
@@ -65,19 +65,13 @@ def new_targets(target_file: pathlib.Path, layout=None, seed: int = SEED, count:
             if len(stored["head_position"]) >= count or bool(stored.get("exhausted", False)):
                 return stored["head_position"][:count].copy()
     poses = make(target_file, layout, seed, count, workers, progress)
+    fingerprint = str(targets.level_head_poses(target_file)["fingerprint"])
     try:
-        _save(cache_dir() / name, poses, str(targets.level_head_poses(target_file)["fingerprint"]))
+        target_generation.save_level_poses(cache_dir() / name, poses, fingerprint,
+                                           extra={"exhausted": poses["exhausted"]})
     except OSError:  # a read-only home: the set is made again next time, and is the same
         pass
     return poses["head_position"].copy()
-
-
-def _save(path: pathlib.Path, poses: dict, fingerprint: str) -> None:
-    """A set in the target files' format (robostrich_suite/targets.py reads it), whole or not at all."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_files.replaced_atomically(path) as handle:
-        np.savez_compressed(handle, fingerprint=np.array(fingerprint), **poses)
-    targets.clear_cache()
 
 
 def make(target_file: pathlib.Path, layout=None, seed: int = SEED, count: int = COUNT, workers: int = 2,

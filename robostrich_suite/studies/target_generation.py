@@ -127,15 +127,17 @@ def recheck(path: pathlib.Path, spec=None, layout=None, settle_time: float = pos
     return len(kept["control"]), count
 
 
-def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str, allow_empty: bool = False) -> int:
+def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str, allow_empty: bool = False,
+                     extra: dict | None = None) -> int:
     """Write ``poses`` (``head_position``, ``head_attitude``, ``control``) as a target file
-    of the arm with ``fingerprint``; returns how many.  Readers of ``path`` see the new file."""
+    of the arm with ``fingerprint``, with the arrays ``extra`` beside them; returns how many.
+    Readers of ``path`` see the new file."""
     path = pathlib.Path(path)
     if not len(poses["head_position"]) and not allow_empty:  # a layout compared may hold none
         raise ValueError(f"no level-head pose to write to {path}: a target file holds at least one")
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_files.replaced_atomically(path) as handle:  # whole or not at all (Ctrl-C, a full disk)
-        np.savez_compressed(handle, fingerprint=np.array(fingerprint),
+        np.savez_compressed(handle, fingerprint=np.array(fingerprint), **(extra or {}),
                             **{key: np.asarray(poses[key]) for key in ("head_position", "head_attitude", "control")})
     targets.clear_cache()
     return len(poses["head_position"])

@@ -343,8 +343,7 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
     domain = as_domain(domain)
     if not domain.is_arm:
         return None
-    digest = lookup_cache.key(domain, heldout_task, track_task, num_targets, new_targets, record,
-                              domain.target_file())
+    digest = lookup_cache.key(domain, heldout_task, track_task, num_targets, new_targets, record)
     restored = lookup_cache.restore(digest, out_dir)
     if restored is not None:
         if on_episode:

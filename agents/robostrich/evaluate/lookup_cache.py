@@ -39,15 +39,14 @@ def _source_digest() -> str:
     return digest.hexdigest()
 
 
-def key(domain, heldout_task: str, track_task: Optional[str], num_targets: Optional[int], new, record: bool,
-        target_file) -> str:
-    """The digest that names a kept evaluation of the lookup (module doc)."""
+def key(domain, heldout_task: str, track_task: Optional[str], num_targets: Optional[int], new, record: bool) -> str:
+    """The digest that names a kept evaluation of the lookup on ``domain`` (module doc)."""
     digest = hashlib.sha256()
     digest.update(repr((FORMAT, domain.info(), heldout_task, track_task, num_targets, record, mujoco.__version__,
                         dm_control.__version__ if hasattr(dm_control, "__version__") else "", np.__version__,
                         _source_digest())).encode())
     digest.update(b"" if new is None else np.ascontiguousarray(new, np.float64).tobytes())
-    digest.update(pathlib.Path(target_file).read_bytes())
+    digest.update(pathlib.Path(domain.target_file()).read_bytes())
     return digest.hexdigest()[:24]
 
 
