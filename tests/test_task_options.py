@@ -113,3 +113,25 @@ def test_target_jitter_moves_each_drawn_target_within_its_radius_and_off_it_draw
     assert np.all(off == 0.0)
     moved = np.min(np.linalg.norm(np.array(drawn[0.02])[:, None] - pool[None], axis=2), axis=1)
     assert np.all(moved <= 0.02) and np.all(moved > 0) and moved.max() > 0.015  # spread over the disk
+
+
+def test_target_between_draws_along_the_segments_to_each_poses_nearest_neighbour_only():
+    pool = np.array([[0.0, 0.2], [0.1, 0.2], [0.1, 0.32], [0.5, 0.5]])
+    nearest = [(0, 1), (1, 0), (2, 1), (3, 2)]  # (pose, its nearest other pose)
+    env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(random=5, target_pool=pool,
+                                                                          target_between=1))
+    drawn = []
+    for _ in range(60):
+        env.reset()
+        drawn.append(env.task.target_position.copy())
+    drawn = np.array(drawn)
+
+    def off_segment(a, b):
+        share = np.clip((drawn - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
+        return np.linalg.norm(drawn - (a + share[:, None] * (b - a)), axis=1)
+    off = np.min([off_segment(pool[i], pool[j]) for i, j in nearest], axis=0)
+    assert np.all(off < 1e-9)
+    assert np.min(np.linalg.norm(drawn[:, None] - pool[None], axis=2), axis=1).max() > 0.04  # between, not at
+    assert len(np.unique(np.round(drawn, 6), axis=0)) > 40
+    with pytest.raises(ValueError, match="target_between must be a whole number of nearest neighbours"):
+        robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(target_between=2.5))
