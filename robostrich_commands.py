@@ -74,11 +74,15 @@ def launch(prog: str) -> int:
     interrupted = []
     previous = {signum: signal.signal(signum, lambda signum, frame: interrupted.append(signum))
                 for signum in (signal.SIGINT, signal.SIGTERM)}
+    shown = _show_loading(prog)
     try:
         cli = getattr(importlib.import_module(module), function)
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+        if shown:
+            sys.stderr.write(CLEAR_LINE)
+            sys.stderr.flush()
     if interrupted:
         terminated = interrupted[-1] == signal.SIGTERM
         print(f"{prog}: {'terminated' if terminated else 'interrupted'}", file=sys.stderr)
@@ -91,6 +95,22 @@ def launch(prog: str) -> int:
         return INTERRUPTED
     finally:
         _ignore_stop_signals()
+
+
+CLEAR_LINE = "\r\033[K"  # back to the line's start, and erase it
+
+
+def _show_loading(prog: str) -> bool:
+    """At a terminal, a note on stderr while the command's libraries load (seconds, before the
+    command can print anything), erased once they have; nothing where stderr is a file or pipe."""
+    try:
+        if not sys.stderr.isatty():
+            return False
+        sys.stderr.write(f"{prog}: loading its libraries...")
+        sys.stderr.flush()
+        return True
+    except (AttributeError, OSError, ValueError):  # no stderr, or a closed one
+        return False
 
 
 def _ignore_stop_signals() -> None:

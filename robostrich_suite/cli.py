@@ -22,6 +22,7 @@ limits below, named in the error), so no flag asks for days or terabytes by acci
 from __future__ import annotations
 
 import argparse
+import re
 import contextlib
 import gc
 import math
@@ -58,6 +59,17 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message):
         self.exit(USER_ERROR, f"{self.prog}: error: {' '.join(message.split())} (--help lists the options)\n")
+
+
+def doc_excerpt(doc: str, start: str, stop: str, names: Optional[dict] = None) -> str:
+    """The words of ``doc`` from ``start`` up to ``stop`` (excluded) as one line of --help text,
+    reST markup taken off and each of ``names`` (a constant's name) replaced by its text (its
+    value): help quotes a module's definition instead of a second copy of it."""
+    text = doc[doc.index(start):doc.index(stop, doc.index(start) + len(start))]
+    text = " ".join(re.sub(r":\w+:`~?([^`]+)`", r"\1", text).replace("``", "").split())
+    for name, shown in (names or {}).items():
+        text = re.sub(rf"\b{re.escape(name)}\b", shown, text)
+    return text.rstrip(" :,;")
 
 
 def interrupted() -> bool:

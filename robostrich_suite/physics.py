@@ -211,6 +211,11 @@ _MUJOCO_WARNINGS = _MujocoWarningCapture()
 logging.getLogger("absl").addFilter(_MUJOCO_WARNINGS)
 
 
+TARGET_RGBA = np.array([0.9, 0.1, 0.1, 1.0], np.float32)  # the target drawn in rendered frames
+TOLERANCE_RGBA = np.array([0.9, 0.1, 0.1, 0.15], np.float32)  # the position tolerance around it
+TARGET_DOT_RADIUS = 0.01  # m
+
+
 class ArmPhysicsMixin:
     """Accessors for the arm's head, joints and tendons, plus divergence capture."""
 
@@ -245,6 +250,32 @@ class ArmPhysicsMixin:
         else:
             views = None
         self.__dict__["_views"] = views
+
+    def show_target_of(self, task) -> None:
+        """Frames from :meth:`render` draw ``task``'s target (its ``target_in_world`` and
+        ``position_tolerance``); the reaching tasks call it as each episode begins."""
+        self.__dict__["_shown_task"] = task
+
+    def render(self, *args, **kwargs):
+        """dm_control's ``render``, with the target drawn where a task has shown one
+        (:meth:`show_target_of`): a red dot inside a faint sphere of the position tolerance.
+        Depth and segmentation frames, which are measurements, are left as the model makes them."""
+        task = self.__dict__.get("_shown_task")
+        measured = kwargs.get("depth", len(args) > 4 and args[4]) or kwargs.get("segmentation", len(args) > 5 and args[5])
+        if task is None or measured or len(args) > 8:
+            return super().render(*args, **kwargs)
+        scene_callback = kwargs.pop("scene_callback", None)
+
+        def draw_target(physics, scene):
+            point = np.asarray(task.target_in_world(physics), np.float64)
+            for radius, rgba in ((float(task.position_tolerance), TOLERANCE_RGBA), (TARGET_DOT_RADIUS, TARGET_RGBA)):
+                if scene.ngeom < scene.maxgeom:
+                    scene.ngeom += 1  # first: the bindings show only the scene's ngeom geoms
+                    mujoco_lib.mjv_initGeom(scene.geoms[scene.ngeom - 1], mujoco_lib.mjtGeom.mjGEOM_SPHERE,
+                                            np.array([radius, 0.0, 0.0]), point, np.eye(3).ravel(), rgba)
+            if scene_callback is not None:
+                scene_callback(physics, scene)
+        return super().render(*args, scene_callback=draw_target, **kwargs)
 
     @property
     def arm_indices(self) -> ArmIndices:

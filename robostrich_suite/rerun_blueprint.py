@@ -19,7 +19,7 @@ SIDE_EYE = rrb.EyeControls3D(position=[0.2, -1.4, 0.5], look_target=[0.2, 0.0, 0
 ROLLOUT_SERIES = (
     ("Position error (m)", ["plots/position_error_m"]),
     ("Head attitude and its error (deg)", ["plots/head_attitude_deg", "plots/attitude_error_deg"]),
-    ("Tendon inputs", ["plots/tendon_input"]),
+    ("Tendon inputs (hover a line for its tendon)", ["plots/tendon_input"]),
 )
 ARM_VIEW = "Arm, target and head path"
 
@@ -27,8 +27,11 @@ ARM_VIEW = "Arm, target and head path"
 def robot_and_series(series: Sequence[tuple[str, Sequence[str]]], eye: rrb.EyeControls3D | None = None,
                      timeline: str = "sim_time", robot: str = ARM_VIEW) -> rrb.Blueprint:
     """The robot (everything under ``world``) in 3D beside one time-series view per ``series`` entry;
-    ``eye`` None lets Rerun place the camera (the quadruped walks out of any fixed view)."""
-    plots = [rrb.TimeSeriesView(name=title, origin="/", contents=[f"+ {path}" for path in paths])
+    ``eye`` None lets Rerun place the camera (the quadruped walks out of any fixed view). A view of
+    one entity has no legend: its title names it, and a legend of a batch's lines (the nine tendon
+    inputs) covers the small plot; hovering a line names it."""
+    plots = [rrb.TimeSeriesView(name=title, origin="/", contents=[f"+ {path}" for path in paths],
+                                plot_legend=rrb.PlotLegend(visible=len(paths) > 1))
              for title, paths in series]
     spatial = rrb.Spatial3DView(name=robot, origin="world", eye_controls=eye)
     return rrb.Blueprint(rrb.Horizontal(spatial, rrb.Vertical(*plots), column_shares=[3, 2]),

@@ -14,6 +14,7 @@ import sys
 import pytest
 
 from agents import checkpoint
+from agents.robostrich.evaluate import evaluation
 from robostrich_suite import targets
 from robostrich_suite.model import layouts
 
@@ -59,6 +60,11 @@ def trained(tmp_path_factory):
     return call("robostrich-train", *TINY_TRAIN, "--out", out), out
 
 
+def kind_of(line: str) -> str:
+    """The evaluation a summary line is about (after the run's label column, before the colon)."""
+    return line[11:].split(":")[0].strip()
+
+
 def test_train_exits_zero_and_writes_its_run(trained):
     result, out = trained
     assert_succeeded(result)
@@ -67,7 +73,7 @@ def test_train_exits_zero_and_writes_its_run(trained):
     lines = result.stdout.strip().splitlines()  # a few lines a person reads; the JSON stays in the files
     assert lines[0].startswith("curriculum ") and "% reached (" in lines[0] and "within 1 cm and 2 deg" in lines[0]
     assert any(line.startswith("lookup ") for line in lines) and "{" not in result.stdout
-    assert [line.split()[0] for line in lines[:5]] == ["curriculum", "heldout_moving", "new", "new_moving", "track"]
+    assert [kind_of(line) for line in lines[:5]] == list(evaluation.KIND_NAMES.values())
     assert lines[-1].startswith(f"wrote {out}/: summary.json") and len(lines) <= 11, result.stdout
     assert not (out / ".lock").exists()  # a clean end leaves only the results
 
@@ -90,12 +96,15 @@ def test_evaluate_exits_zero_on_a_checkpoint(trained, tmp_path):
     assert_succeeded(result)
     assert (tmp_path / "ev" / "summary.json").stat().st_size > 0
     lines = result.stdout.strip().splitlines()
-    kinds = ["heldout_moving", "new", "new_moving", "track"]
-    firsts = ["eval", *kinds, "lookup", *kinds]  # label, then its kinds
-    assert [line.split()[0] for line in lines[:-1]] == firsts and lines[0].split()[1] == "heldout", result.stdout
+    assert [line.split()[0] for line in lines[:-1] if not line.startswith(" ")] == ["eval", "lookup"], result.stdout
+    assert [kind_of(line) for line in lines[:-1]] == 2 * list(evaluation.KIND_NAMES.values()), result.stdout
     assert lines[-1] == f"wrote {tmp_path / 'ev'}/: summary.json, reports", result.stdout
     # the evaluation's progress bar, ending at all its episodes (what it shows before depends on the speed)
     assert re.search(r"evaluation: 100%.* (\d+)/\1 \[", result.stderr) and "episode" in result.stderr, result.stderr
+    # its first line, before the seconds of rebuilding the run: what it will evaluate
+    assert result.stderr.startswith(f"evaluating {out / 'curriculum' / 'checkpoint.ckpt'} on robostrich "
+                                    "(ventral_slips): held-out targets, new targets, the track task, and the lookup"), \
+        result.stderr
 
 
 def test_a_checkpoint_whose_stored_plan_is_damaged_is_named_in_one_line(trained, tmp_path):
@@ -229,3 +238,43 @@ def test_import_without_display_prints_no_glfw_error():
     assert result.returncode == 0, result.stderr
     assert "GLFW" not in result.stderr and "DISPLAY" not in result.stderr, result.stderr
     assert result.stdout.strip() in ("egl", "osmesa", "disable")
+
+
+def test_at_a_terminal_a_command_notes_its_loading_then_erases_the_note():
+    """The seconds a command's libraries take to load are not silent at a terminal; the note is gone
+    before the command's own first line (and never reaches a file or a pipe)."""
+    import pty
+    from conftest import console_script
+    controller, terminal = pty.openpty()
+    process = subprocess.Popen([console_script("robostrich-export-xml"), "--no-such-flag"], stdin=subprocess.DEVNULL,
+                               stdout=subprocess.PIPE, stderr=terminal)
+    os.close(terminal)
+    shown = b""
+    while True:
+        try:
+            chunk = os.read(controller, 4096)
+        except OSError:  # the command closed its end
+            break
+        if not chunk:
+            break
+        shown += chunk
+    os.close(controller)
+    assert process.wait(timeout=120) == 2
+    note = b"robostrich-export-xml: loading its libraries..."
+    assert shown.startswith(note + b"\r\x1b[K"), shown
+    assert shown[len(note) + 4:].decode().startswith("robostrich-export-xml: error: "), shown
+    piped = call("robostrich-export-xml", "--no-such-flag")
+    assert "loading" not in piped.stderr and piped.stderr.count("\n") == 1, piped.stderr
+
+
+def test_training_first_says_what_it_trains_how_short_it_is_and_what_the_bar_shows():
+    from agents.robostrich.train import command
+    argv = ["--steps", "30000", "--no-baseline", "--out", "runs/quick"]
+    args = command.build_parser().parse_args(argv)
+    lines = command.start_lines(args, command.prepare(args, argv))
+    assert lines[0] == ("training curriculum (lesson1 8,000, lesson2 8,000, lesson3 14,000 control steps) on robostrich "
+                        "(ventral_slips), seed 0, into runs/quick/"), lines
+    assert lines[1].startswith("30,000 control steps per run are 15 % of the main job's 200,000"), lines
+    assert "return is the mean return of the last 20 training episodes, reached the share" in lines[2]
+    args = command.build_parser().parse_args([])
+    assert len(command.start_lines(args, command.prepare(args, []))) == 2  # the main job's budget: no warning

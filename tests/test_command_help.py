@@ -154,3 +154,35 @@ def test_one_name_per_idea_across_commands():
                 if idea in text:
                     named.setdefault(idea, set()).add(match.group(2))
     assert named == {"progress bar": {"--no-progress"}, ".rrd": {"--no-rerun"}}, named
+
+
+def stored_help(prog: str) -> str:
+    import robostrich_commands
+    return " ".join(open(robostrich_commands.help_path(prog), encoding="utf-8").read().split())
+
+
+def test_help_defines_its_terms_instead_of_pointing_at_the_source():
+    """What a flag or a word means is in the help itself: no "(module doc)", no file to read for a
+    flag's meaning, no Python tuple as a default, no constant's name where its value belongs."""
+    from agents.robostrich.robustness import command as robustness
+    from robostrich_suite.model import layouts
+    from robostrich_suite.tasks import perturbations
+    texts = {prog: stored_help(prog) for prog in COMMANDS}
+    for prog, text in texts.items():
+        assert "module doc" not in text and "(default: (" not in text, prog
+        assert not re.search(r"\b[A-Z][A-Z0-9]+(_[A-Z0-9]+)*_AT_1\b", text), prog
+    robust = texts["robostrich-robustness"]
+    assert "(default: " + ",".join(f"{s:g}" for s in robustness.DEFAULT_SCALES) + ")" in robust
+    assert all(f"* {family}" in robust for family in perturbations.FAMILIES), robust
+    assert "passage" in texts["robostrich-design"] and "before anything touches" in texts["robostrich-design"]
+    assert "P_d, the head's desired distance ahead of the trunk centre" in texts["robostrich-stabilize"]
+    assert "blue region of Fig. 6 (where the links can put the head level" in texts["robostrich-layouts"]
+
+
+
+def test_the_layout_file_example_in_help_is_a_file_the_commands_read(tmp_path):
+    from robostrich_suite.model import layouts
+    example = stored_help("robostrich-layouts").split("for example ", 1)[1]
+    (tmp_path / "example.json").write_text(example)
+    name, layout = layouts.read_file(tmp_path / "example.json")
+    assert name == "two_dorsal" and [t.name for t in layout.tendons] == ["dorsal", "ventral_skip"]

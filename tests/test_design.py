@@ -302,15 +302,19 @@ def test_a_killed_search_resumes_with_its_finished_trials_intact(tmp_path):
     assert json.loads((out / "design.json").read_text())["trials"]["complete"] == len(before) + 1
 
 
-def test_ctrl_c_marks_the_running_trial_failed_and_keeps_the_finished_ones(tmp_path):
+@pytest.mark.parametrize("signum, status, word", [(signal.SIGINT, 130, "interrupted"),
+                                                   (signal.SIGTERM, 143, "terminated")])
+def test_a_stop_marks_the_running_trial_failed_keeps_the_finished_ones_and_says_one_line(tmp_path, signum,
+                                                                                        status, word):
     out = tmp_path / "out"
     db = out / "study.db"
     process = _start(out, 50)
     _wait_for_a_complete_trial(process, db)
-    process.send_signal(signal.SIGINT)
+    process.send_signal(signum)
     _, stderr = process.communicate(timeout=120)
-    assert process.returncode == 130, stderr[-3000:]
-    assert stderr.strip().splitlines()[-1] == "robostrich-design: interrupted"
+    assert process.returncode == status, stderr[-3000:]
+    shown = [line for line in stderr.replace("\r", "\n").splitlines() if line.strip() and "routings:" not in line]
+    assert shown == [f"robostrich-design: {word}"], stderr[-3000:]  # no Optuna warning, no traceback
     states = [state for state, _, _ in _trials(db).values()]
     assert "RUNNING" not in states and states.count("COMPLETE") >= 1
 

@@ -73,6 +73,31 @@ def test_step_after_the_episode_ended_asks_for_a_reset():
         env.step(np.zeros(9, np.float32))
 
 
+def red_pixels(frame):
+    frame = frame.astype(int)
+    return (frame[..., 0] > 2 * frame[..., 1] + 30) & (frame[..., 0] > 2 * frame[..., 2] + 30)  # not the orange head
+
+
+def test_a_rendered_frame_draws_the_target_where_the_task_puts_it_and_depth_stays_a_measurement():
+    import os
+    if os.environ.get("MUJOCO_GL") != "egl":
+        pytest.skip("renders under MUJOCO_GL=egl")
+    env = gym_adapter.make("robostrich", "lesson2", seed=0, render_mode="rgb_array", width=200, height=150)
+    env.reset(seed=0)
+    physics, task = env.unwrapped.dm_env.physics, env.unwrapped.dm_env.task
+    centres = []
+    for target in ([-0.2, 0.3], [0.2, 0.3]):
+        task.target_position = np.array(target)
+        red = red_pixels(env.render())
+        assert red.sum() > 20, red.sum()
+        centres.append(np.argwhere(red).mean(axis=0))
+    assert abs(centres[1][1] - centres[0][1]) > 10  # 40 cm along the arm's plane: the dot moves across the frame
+    depth = physics.render(height=150, width=200, camera_id="side", depth=True)
+    physics.show_target_of(None)
+    assert red_pixels(physics.render(height=150, width=200, camera_id="side")).sum() == 0  # the robot has no red
+    np.testing.assert_array_equal(depth, physics.render(height=150, width=200, camera_id="side", depth=True))
+
+
 def test_rgb_array_render_shows_the_arm_and_check_env_renders():
     """render_mode='rgb_array': a real frame under EGL."""
     import os

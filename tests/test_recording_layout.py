@@ -2,6 +2,7 @@
 the head, in the layout it carries (robostrich_suite/rerun_blueprint.py), so that the native viewer
 and `--web` open on the robot and its errors instead of Rerun's guess."""
 import numpy as np
+import rerun as rr
 
 import robostrich_suite
 from agents.robostrich.recording import RolloutRecorder, log_training_curves
@@ -33,6 +34,10 @@ def test_a_rollout_of_the_arm_shows_every_link_and_opens_in_the_rollout_layout(t
     assert not missing, missing  # capsules were once skipped: a numpy geom type is never `in` a tuple of enums
     assert {"/world/target", "/world/head", "/world/head_path", "/plots/position_error_m"} <= entities
     assert sorted(rrd_view_names(tmp_path / "arm.rrd")) == sorted(ROLLOUT_VIEWS)
+    names = [chunk.to_record_batch().column("SeriesLines:names").to_pylist()
+             for chunk in rr.chunk.RrdReader(str(tmp_path / "arm.rrd")).stream()
+             if chunk.entity_path == "/plots/tendon_input" and chunk.is_static]
+    assert names == [[[tendon.split("/")[-1] for tendon in env.physics.tendon_names()]]], names  # not [0]..[8]
 
 
 def test_the_arm_on_the_quadruped_shows_its_legs_and_training_curves_open_in_their_grid(tmp_path):

@@ -41,6 +41,8 @@ class RolloutRecorder:
             self._geometry_logged = True
             self.file.send_blueprint(rerun_blueprint.rollout(side_view=not hasattr(env.physics, "from_trunk_frame")))
             rerun_log.log_geometry(self.rec, env.physics)
+            self.rec.log("plots/tendon_input", rr.SeriesLines(  # each line by its tendon's name, not [0]..[8]
+                names=[name.split("/")[-1] for name in env.physics.tendon_names()]), static=True)
         rerun_log.log_body_poses(self.rec, env.physics)
 
     def log_step(self, env, action, timestep, measured):

@@ -48,6 +48,13 @@ MAX_TENDONS = 9  # the paper's 9 servos: the built-ins compare at the same actua
 MAX_FILE_TENDONS = 20
 DATA_DIR = pathlib.Path(__file__).resolve().parents[1] / "data"
 
+
+def example_file() -> str:
+    """The module doc's example layout file as one line of JSON (what --help shows)."""
+    import tomllib
+    block = __doc__.split("::", 1)[1].split("\n\n")[1]
+    return json.dumps(tomllib.loads("\n".join(line.strip() for line in block.splitlines())))
+
 # Antagonist pairs: the neck cut into four stretches, each with a dorsal and a ventral
 # slip between the same two links, plus the paper's dorsal tendon to the head.  The
 # passive neck is an inverted pendulum; a stretch pulled from both sides holds its bend

@@ -132,8 +132,9 @@ def build_parser() -> cli_lib.Parser:
                         help="the gap's slot centred within MIN..MAX m ahead of the base joint, fixed for a study "
                              "(default: anywhere; the task's slot is at 0.36; a negative MIN: --slot-x=-0.1,0.1)")
     parser.add_argument("--score-passage", action="store_true",
-                        help="score the way into the gap from under the shelf instead of the column's height, "
-                             "fixed for a study (module doc)")
+                        help="the second objective becomes the way into the gap instead of the column's height: how "
+                             "far up through the slot the head gets from under the shelf before anything touches (m "
+                             "from the shelf's top), plus the column's height once a way reaches it; fixed for a study")
     parser.add_argument("--dorsal-tendons", type=cli_lib.whole_number(*design_space.DORSAL_RANGE),
                         default=design_space.DORSAL_TENDONS, metavar="M",
                         help="dorsal tendons per routing, fixed for a study (default: %(default)s, the paper's)")

@@ -160,8 +160,9 @@ def print_summary(result: dict, out: pathlib.Path) -> None:
         print(f"  trial {row['trial']}: coverage {row['coverage']:.0%}, gap column {100 * row['gap_column_m']:.1f} cm"
               f"{way_in}, rolling/lever {row['rolling_lever_ratio']:.2f}")
     need = result["need"]["column_height_m"]
-    print(f"best gap column {100 * result['best_feasible_gap_column_m']:.1f} cm with rolling/lever <= "
-          f"{result['ratio_limit']:g}, {100 * result['best_gap_column_m']:.1f} cm of any routing (the narrow gap needs "
+    print(f"best gap column {100 * result['best_feasible_gap_column_m']:.1f} cm among routings whose rolling/lever "
+          f"attitude ratio is <= {result['ratio_limit']:g} (the paper's 'well below 1'), "
+          f"{100 * result['best_gap_column_m']:.1f} cm of any routing (the narrow gap needs "
           f"{100 * need:.0f} cm above its shelf)")
     for row in result["confirmed"]:
         print(f"  confirmed trial {row['trial']}: coverage {row['coverage']:.0%}, gap column "

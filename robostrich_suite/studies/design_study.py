@@ -56,8 +56,11 @@ class Settings:
 
 
 def _optuna():
+    """Optuna, saying nothing below an error: a trial that fails (Ctrl-C, SIGTERM or a defect)
+    raises to the command (``catch=()``), which ends in its one line; Optuna's warning would repeat
+    it with a traceback first."""
     import optuna
-    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    optuna.logging.set_verbosity(optuna.logging.ERROR)
     return optuna
 
 

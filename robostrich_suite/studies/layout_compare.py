@@ -281,13 +281,18 @@ def build_parser() -> cli_lib.Parser:
     parser = cli_lib.Parser(
         prog=PROG,
         description="Compare tendon layouts (and passive joint stiffnesses) of the Robostrich "
-                    "arm on the same Table 1 links: share of the blue region of Fig. 6 held "
-                    "level (coverage), distinct level targets, rolling/lever attitude ranges, "
+                    "arm on the same Table 1 links: share of the blue region of Fig. 6 (where the links "
+                    "can put the head level, 90+-5 deg) held level by the tendons (coverage), distinct level targets, rolling/lever attitude ranges, "
                     "and, from the agent's side, held-out success of the lookup baseline (and, "
                     "with --train, of a short curriculum run). Writes layouts.md, layouts.csv, layouts.png and "
                     "targets/LAYOUT.npz under --out.",
         epilog="built-in layouts: " + " ".join(f"{name}: {_plain(b.description)}."
-                                                 for name, b in layouts_lib.BUILT_IN.items()))
+                                                 for name, b in layouts_lib.BUILT_IN.items())
+               + " Layout files (--layout-file): " + cli_lib.doc_excerpt(
+                   layouts_lib.__doc__, "JSON or TOML", "::", {
+                       "arm.HOLE_OFFSET_RANGE": "{:g}-{:g} m".format(*arm_lib.HOLE_OFFSET_RANGE),
+                       ", as TendonSpec.spanning": ""})
+               + ", for example " + layouts_lib.example_file())
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/layouts"),
                         help="output directory (default: %(default)s)")
     parser.add_argument("--layouts", nargs="*", default=list(layouts_lib.BUILT_IN),
@@ -299,8 +304,7 @@ def build_parser() -> cli_lib.Parser:
                              "C16, C14, ..., C2: " + ", ".join(layouts_lib.fig1b_candidates())
                              + ") instead of --layouts")
     parser.add_argument("--layout-file", nargs="+", default=[], type=pathlib.Path, metavar="FILE",
-                        help="also compare layouts from JSON/TOML files (see "
-                             "robostrich_suite/model/layouts.py for the format; default: none)")
+                        help="also compare layouts from JSON/TOML files (their format: below; default: none)")
     parser.add_argument("--stiffness", nargs="+", type=cli_lib.number(1e-6, 1e4, " N m/rad"), default=[],
                         metavar="N_M_PER_RAD",
                         help="passive joint stiffnesses to sweep, every layout at each "

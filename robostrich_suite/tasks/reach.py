@@ -222,6 +222,7 @@ class Reach(base.Task):
         if self.observe_sent_actions:
             self._sent_actions = np.tile(physics.arm_control(), (self.observe_sent_actions, 1))
         self.target_position = self.next_target()
+        physics.show_target_of(self)
         super().initialize_episode(physics)
         self._continues_from_physics = True
         self._next_start = None

@@ -7,6 +7,7 @@ new targets are robostrich-train's too.
 """
 import argparse
 import os
+import sys
 from typing import Optional
 
 import numpy as np
@@ -91,6 +92,12 @@ def main(argv=None):
         raise ValueError("--web serves the track task's recordings, and this evaluation runs no track task")
     heldout_task = check_heldout_task(domain, args.heldout_task
                                       or default_heldout_task(domain, parse_plan(fingerprint["plan"])[-1].task))
+    if not args.quiet:  # before the seconds of making new targets and rebuilding the run
+        kinds = ["held-out targets"] + (["new targets"] if domain.is_arm and args.new_targets != 0 else []) \
+            + ([f"the {track_task} task"] if track_task else [])
+        print(f"evaluating {args.checkpoint} on {domain.name}" + (f" ({domain.layout})" if domain.layout else "")
+              + f": {', '.join(kinds)}" + (", and the lookup baseline on the same" if domain.is_arm else ""),
+              file=sys.stderr, flush=True)
     new = new_targets_of(domain, args, args.num_targets)
     run = load_run_from_checkpoint(args.checkpoint)
     actor = SACBuilder.make_eval_actor(run.loop)
@@ -127,5 +134,4 @@ def cli(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    import sys
     sys.exit(cli())

@@ -33,6 +33,8 @@ from robostrich_suite.tasks.measurement import measure
 MAX_TARGETS = 10_000  # held-out targets (or seeded episodes off the arm) of one evaluation
 target_count = cli_lib.whole_number(1, MAX_TARGETS)  # argparse type of the target counts
 REPORT_KINDS = ("heldout", "heldout_moving", "new", "new_moving", "track")  # of evaluate_agent, in its order
+KIND_NAMES = {"heldout": "held-out, fixed start", "heldout_moving": "held-out, moving starts",  # as printed
+              "new": "new targets, fixed start", "new_moving": "new targets, moving starts", "track": "track"}
 
 
 def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dict:
@@ -311,7 +313,7 @@ def summary_lines(runs: dict) -> list:
     lines = []
     for label, kinds in runs.items():
         for kind, s in kinds.items():
-            head = f"{label:10s} {kind:14s}"
+            head = f"{label:10s} {KIND_NAMES.get(kind, kind) + ':':27s}"
             label = ""
             if "success_rate" not in s:
                 lines.append(f"{head} return {s['return_mean']:.1f} mean [{s['return_min']:.1f}, "

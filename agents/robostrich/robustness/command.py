@@ -197,13 +197,21 @@ def build_parser() -> cli_lib.Parser:
     parser = cli_lib.Parser(prog="robostrich-robustness",
                             description="Held-out success of a policy (and the lookup baseline) as the robot "
                                         "differs from its model: one family of differences at a time at "
-                                        "increasing scale, then all at once. Writes robustness.json and .png.")
+                                        "increasing scale, then all at once. Writes robustness.json and .png.",
+                            epilog="What scale s does to each family (per episode, relative to the model): "
+                                   + cli_lib.doc_excerpt(perturbations.__doc__, "* ``mass``", "With ``vary``", {
+                                       "TENDON_LENGTH_AT_1": f"{perturbations.TENDON_LENGTH_AT_1:g} m",
+                                       "FRICTION_AT_1": f"{perturbations.FRICTION_AT_1:g} N m",
+                                       "JOINT_NOISE_AT_1": f"{perturbations.JOINT_NOISE_AT_1:g} rad",
+                                       "LATENCY_STEPS_PER_SCALE": f"{perturbations.LATENCY_STEPS_PER_SCALE:g}",
+                                       "MAX_LATENCY_STEPS": f"{perturbations.MAX_LATENCY_STEPS}",
+                                       "TRUNK_HEIGHT_AT_1": f"{perturbations.TRUNK_HEIGHT_AT_1:g} m"}))
     parser.add_argument("policy", help=f"a shipped policy ({', '.join(policies.SHIPPED)}), a policy file (.npz) "
                                        "or a robostrich-train checkpoint (checkpoint.ckpt)")
     parser.add_argument("--out", default="out/robustness", help="directory for robustness.json and .png (default: %(default)s)")
     parser.add_argument("--scales", type=scale_list, default=DEFAULT_SCALES,
-                        help="scales s, comma-separated, 0 to 1 (default: %(default)s); what s means per family: "
-                             "robostrich_suite/tasks/perturbations.py")
+                        help="scales s, comma-separated, 0 to 1 (default: " + ",".join(f"{s:g}" for s in DEFAULT_SCALES)
+                             + "); what s means per family: below")
     parser.add_argument("--num-targets", type=evaluation.target_count, default=None,
                         help="held-out targets (default: all)")
     parser.add_argument("--lookup", action=argparse.BooleanOptionalAction, default=True,

@@ -153,6 +153,8 @@ def main(argv=None):
     outputs.check_directory(args.out)  # before a minute of building, not after an hour of training
     setup = prepare(args, argv)
     init = check_run_directory(args, setup)
+    if not args.quiet:  # before seconds of building and compiling, what they are for
+        print("\n".join(start_lines(args, setup)), file=sys.stderr, flush=True)
     with lock_run_directory(args.out):  # released, and its file removed, however this ends
         finished = finished_summary(args, setup)
         if finished is not None:  # a --resume of a finished run: its results, not a second evaluation
@@ -162,6 +164,23 @@ def main(argv=None):
         specs, runs = start_runs(args, argv, setup, init)
         outcomes, lookup = train_all(args, setup, specs, runs)
         return report(args, setup, specs, outcomes, lookup)
+
+
+def start_lines(args, setup: TrainingSetup) -> list:
+    """What the command is about to do, in words (on stderr with the progress bar): each run's
+    lessons and control steps, how a shorter budget compares with the main job's, and the bar's terms."""
+    runs = " and ".join(f"{label} ({', '.join(f'{l.task} {l.steps:,}' for l in plan)} control steps)"
+                        for label, plan in setup.run_plans.items())
+    where = setup.domain.name + (f" ({setup.domain.layout})" if setup.domain.layout else "")
+    lines = [f"{'resuming' if args.resume else 'training'} {runs} on {where}, seed {args.seed}, into {args.out}/"]
+    main_steps = MAIN_JOB_STEPS.get(setup.domain.name)
+    steps = max(sum(l.steps for l in plan) for plan in setup.run_plans.values())
+    if main_steps and steps < main_steps:
+        lines.append(f"{steps:,} control steps per run are {100 * steps / main_steps:.2g} % of the main job's {main_steps:,}: "
+                     "expect a weaker policy than docs/results.md reports")
+    lines.append("progress: return is the mean return of the last 20 training episodes, reached the share of the "
+                 "last 50 that reached their target; each held-out evaluation prints a line as it ends")
+    return lines
 
 
 def start_runs(args, argv, setup: TrainingSetup, init: dict):

@@ -122,6 +122,8 @@ def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
                 record["lesson_end"] = True
             with open(r.evals_path, "a") as f:
                 f.write(json.dumps(record) + "\n")
+            if progress is not None:
+                progress.periodic(r.name, record)
 
         start, start_steps = time.time(), run.loop.env_steps
         with atomic_files.naming(run.run_dir, only_unnamed=True), cli_lib.deferred_interrupts():

@@ -1,9 +1,12 @@
 """robostrich-train's progress bars: one over every run's control steps, one over the final
 evaluations' episodes, and the stand-in a worker process forwards its progress through."""
+import sys
 from collections import deque
 
 import numpy as np
 from tqdm import tqdm
+
+from agents.robostrich.evaluate.evaluation import outcome_text
 
 
 def lesson_text(run) -> str:
@@ -13,7 +16,7 @@ def lesson_text(run) -> str:
 
 class Progress:
     """tqdm bar over all control steps of all runs: steps/s, run, lesson, recent return and
-    success; then a second bar over the final evaluations' episodes (``evaluations`` of them)."""
+    success, with a line above it per periodic evaluation; then a second bar over the final evaluations' episodes (``evaluations`` of them)."""
 
     def __init__(self, total: int, enabled: bool = True, evaluations: int = 0):
         self.bar = self.eval_bar = None
@@ -52,10 +55,17 @@ class Progress:
         if self.bar is None:
             return
         self.bar.update(n)
-        self.bar.set_postfix(run=label, lesson=lesson,
-                             ret=f"{np.mean(self.returns) if self.returns else float('nan'):.1f}",
-                             succ=f"{np.mean(self.successes) if self.successes else float('nan'):.2f}",
+        self.bar.set_postfix({"run": label, "lesson": lesson,  # in this order (keywords would be sorted)
+                              "return": f"{np.mean(self.returns) if self.returns else float('nan'):.1f}",
+                              "reached": f"{np.mean(self.successes) * 100 if self.successes else float('nan'):.0f}%"},
                              refresh=False)
+
+    def periodic(self, label: str, record: dict):
+        """One line above the bar for a periodic held-out evaluation of run ``label`` (its evals.jsonl record)."""
+        if self.bar is None or "success_rate" not in record["summary"]:
+            return
+        self.bar.write(f"{label} at {record['env_steps']:,} control steps: held-out "
+                       f"{outcome_text('heldout', record['summary']).strip()}", file=sys.stderr)
 
     def reset_window(self):
         self.returns.clear()
@@ -86,3 +96,6 @@ class QueueProgress:
 
     def evaluated(self, n: int = 1):
         self.queue.put(("evaluated", self.label, n))
+
+    def periodic(self, label: str, record: dict):
+        self.queue.put(("periodic", label, record))

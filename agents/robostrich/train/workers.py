@@ -119,6 +119,8 @@ def _supervise(context, specs, job, progress, workers, queue, active, ends):
             progress.on_episode(payload)
         elif kind == "evaluated":
             progress.evaluated(payload)
+        elif kind == "periodic":
+            progress.periodic(label, payload)
         elif kind == "resumed":
             progress.skip(payload)
         elif label in active:  # the first word on how it ended
