@@ -165,7 +165,6 @@ def test_help_defines_its_terms_instead_of_pointing_at_the_source():
     """What a flag or a word means is in the help itself: no "(module doc)", no file to read for a
     flag's meaning, no Python tuple as a default, no constant's name where its value belongs."""
     from agents.robostrich.robustness import command as robustness
-    from robostrich_suite.model import layouts
     from robostrich_suite.tasks import perturbations
     texts = {prog: stored_help(prog) for prog in COMMANDS}
     for prog, text in texts.items():
