@@ -68,15 +68,23 @@ CURRICULUM_TASKS = tuple((domain, task) for domain, module in _DOMAINS.items()
                          for task in module.SUITE.tagged("curriculum"))
 
 
-def _register_gymnasium_environments():
+def _register_gymnasium_environments() -> list[str]:
     """With gymnasium installed (the ``gym`` extra), ``gymnasium.make("robostrich/lesson2-v0")``
-    works after ``import robostrich_suite``: see ``robostrich_suite.gym_adapter``."""
+    works after ``import robostrich_suite``: every task as ``DOMAIN/TASK-v0``, made by
+    ``robostrich_suite.gym_adapter.make``, which gymnasium imports by name when one is made (so
+    the package never imports its adapter, which imports the package). Returns the ids."""
     try:
-        import gymnasium  # noqa: F401
+        import gymnasium
     except ImportError:
-        return
-    from robostrich_suite import gym_adapter
-    gym_adapter.register_environments()
+        return []
+    ids = []
+    for domain, task in ALL_TASKS:
+        env_id = f"{domain}/{task}-v0"
+        if env_id not in gymnasium.registry:
+            gymnasium.register(id=env_id, entry_point="robostrich_suite.gym_adapter:make",
+                               kwargs=dict(domain_name=domain, task_name=task))
+        ids.append(env_id)
+    return ids
 
 
 _register_gymnasium_environments()

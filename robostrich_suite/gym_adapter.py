@@ -153,16 +153,3 @@ def make(domain_name: str, task_name: str, seed: int | None = None,
 
 
 make.metadata = GymnasiumEnv.metadata  # gymnasium.make reads the entry point's render modes here
-
-
-def register_environments() -> list[str]:
-    """Register every task as ``DOMAIN/TASK-v0`` with gymnasium (done on ``import
-    robostrich_suite`` when gymnasium is installed); returns the ids."""
-    ids = []
-    for domain, task in robostrich_suite.ALL_TASKS:
-        env_id = f"{domain}/{task}-v0"
-        if env_id not in gymnasium.registry:
-            gymnasium.register(id=env_id, entry_point="robostrich_suite.gym_adapter:make",
-                               kwargs=dict(domain_name=domain, task_name=task))
-        ids.append(env_id)
-    return ids

@@ -12,7 +12,7 @@ import pytest
 import robostrich_suite
 from robostrich_suite import scenes, targets
 from robostrich_suite.model import arm, layouts
-from robostrich_suite.studies import design, design_objectives, design_space, gap_column, gap_passage, layout_compare
+from robostrich_suite.studies import design, design_objectives, design_space, design_study, gap_column, gap_passage, layout_compare
 
 import results_page
 from conftest import console_script
@@ -148,7 +148,7 @@ def test_a_tiny_search_keeps_the_papers_routing_and_drops_the_one_from_the_base(
     rows = {row["trial"]: row for row in summary["front"]}
     # ventral_from_base (trial 0) fails the paper's rolling/lever test, ventral_slips (trial 1) passes it.
     assert summary["trials"]["complete"] == 2 and summary["trials"]["feasible"] == 1
-    assert list(rows) == [1] and rows[1]["rolling_lever_ratio"] < design.RATIO_LIMIT
+    assert list(rows) == [1] and rows[1]["rolling_lever_ratio"] < design_study.RATIO_LIMIT
     written = json.loads((out / "design.json").read_text())
     assert written["benchmark"] == "design" and written["command"].startswith("robostrich-design --trials 2")
     assert (out / "front.png").stat().st_size > 0

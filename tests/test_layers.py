@@ -134,3 +134,73 @@ def test_the_agent_imports_the_projects_modules_at_the_top():
             if own and not any((where, t) in LAZY_IMPORTS for t in own):
                 hidden.add(f"{where}:{node.lineno} imports {min(own)} inside a function")
     assert not hidden, "\n".join(sorted(hidden))
+
+
+def project_modules() -> dict:
+    """Every module of both packages: its dotted name -> its file."""
+    found = {}
+    for package in ("robostrich_suite", "agents"):
+        for path in sorted((ROOT / package).rglob("*.py")):
+            found[".".join(path.relative_to(ROOT).with_suffix("").parts).removesuffix(".__init__")] = path
+    return found
+
+
+def import_circles(graph: dict) -> list:
+    """The groups of modules that import each other round a circle (strongly connected, more than
+    one module), each sorted; an iterative Tarjan, so that a deep chain needs no recursion."""
+    index, low, on_stack, stack, circles = {}, {}, set(), [], []
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, targets = work[-1]
+            target = next(targets, None)
+            if target is not None:
+                if target not in index:
+                    index[target] = low[target] = len(index)
+                    stack.append(target)
+                    on_stack.add(target)
+                    work.append((target, iter(sorted(graph[target]))))
+                elif target in on_stack:
+                    low[node] = min(low[node], index[target])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                group = []
+                while True:
+                    member = stack.pop()
+                    on_stack.discard(member)
+                    group.append(member)
+                    if member == node:
+                        break
+                if len(group) > 1:
+                    circles.append(sorted(group))
+    return circles
+
+
+def test_the_circle_finder_finds_a_circle_and_nothing_else():
+    assert import_circles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert import_circles({"a": {"b"}, "b": set()}) == []
+
+
+def test_no_two_modules_import_each_other_even_inside_functions():
+    """An import circle, even through a function-level import, ties modules that should be read
+    (and changed) one after the other; none of either package has one."""
+    found = project_modules()
+    graph = {}
+    for module, path in found.items():
+        targets = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                targets.update(a.name for a in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.module:
+                targets.update(f"{node.module}.{a.name}" if f"{node.module}.{a.name}" in found else node.module
+                               for a in node.names)
+        graph[module] = {t for t in targets if t in found and t != module}
+    assert import_circles(graph) == []

@@ -16,7 +16,7 @@ three are fixed for a study, as ``--pose-budget`` is, and ``--start-from`` must 
 
 **Two objectives and one constraint.**  Maximised: the share of the blue region held level
 (coverage) and the height of the gap column (the narrow gap's measure).  Constrained: the
-rolling/lever attitude ratio at most :data:`RATIO_LIMIT`, the paper's "well below 1" made a
+rolling/lever attitude ratio at most :data:`design_study.RATIO_LIMIT`, the paper's "well below 1" made a
 number (the Fig. 1B candidates measure 0.31-0.42; routings from the base 1.25-2).  The ratio is a
 test the paper's arm passes, not a quantity to trade, so it bounds the search instead of
 spreading the front over a third axis; coverage and the gap column do trade (a neck that rises
@@ -63,22 +63,13 @@ import warnings
 
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs
-from robostrich_suite.studies import design_space
+from robostrich_suite.studies import design_report, design_space, design_study
 
 PROG = "robostrich-design"
-RATIO_LIMIT = 0.6  # rolling / lever attitude ratio a routing must not pass (module doc)
-OBJECTIVES = ("coverage", "gap_column_m")  # both maximised
-PASSAGE_OBJECTIVES = ("coverage", "gap_passage_m")  # with --score-passage
 SLOT_X_LIMIT = 1.0  # m: --slot-x within this of the base joint
 MAX_TRIALS = 100_000
 MAX_POSE_BUDGET = 2_000
 MIN_POSE_BUDGET = 6  # two coverage cells, three column targets, one to grow a column
-HEARTBEAT_S, GRACE_S = 30, 120  # a trial silent this long was on a machine that died: failed
-FRONT_LAYOUTS = 10  # the front's routings written as layout files, best gap column first
-
-
-def objectives(score_passage: bool) -> tuple:
-    return PASSAGE_OBJECTIVES if score_passage else OBJECTIVES
 
 
 def slot_range(text: str) -> tuple:
@@ -157,7 +148,6 @@ def build_parser() -> cli_lib.Parser:
 
 def main(argv=None) -> dict:
     args = build_parser().parse_args(argv)
-    from robostrich_suite.studies import design_report, design_study
     space = design_space.Space(args.dorsal_tendons, args.ventral_tendons, args.max_hole_stride)
     starts = [design_study.start_layout(item, space) for item in args.start_from]  # bad ones fail before any work
     outputs.check_directory(args.out)

@@ -30,10 +30,9 @@ def trial_row(trial, layout_file: str | None = None) -> dict:
 
 
 def write_layouts(front, out: pathlib.Path) -> dict:
-    """The front's first ``design.FRONT_LAYOUTS`` routings as ``OUT/layouts/trial_N.json``: {number: path}."""
-    from robostrich_suite.studies import design
+    """The front's first ``design_study.FRONT_LAYOUTS`` routings as ``OUT/layouts/trial_N.json``: {number: path}."""
     written = {}
-    for trial in front[:design.FRONT_LAYOUTS]:
+    for trial in front[:design_study.FRONT_LAYOUTS]:
         layout = design_space.layout(trial.params)
         path = out / "layouts" / f"trial_{trial.number}.json"
         atomic_files.write_text(path, json.dumps(layouts_lib.to_dict(layout, f"design_trial_{trial.number}"), indent=1) + "\n")
@@ -57,7 +56,6 @@ def rate(trials) -> dict:
 
 def summary(study, command: str, storage_url: str, layout_files: dict, confirmed: list) -> dict:
     import optuna
-    from robostrich_suite.studies import design
     complete = design_study.complete_trials(study)
     front = design_study.pareto_front(study)
     states = [t.state for t in study.get_trials(deepcopy=False)]
@@ -79,8 +77,8 @@ def summary(study, command: str, storage_url: str, layout_files: dict, confirmed
                     "max_hole_stride": settings.space.max_stride},
         "gap_objective": "passage" if settings.score_passage else "column",
         "sampler": "multi-objective TPE with constraints (Optuna)",
-        "objectives": list(design.objectives(settings.score_passage)),
-        "ratio_limit": design.RATIO_LIMIT,
+        "objectives": list(design_study.objectives(settings.score_passage)),
+        "ratio_limit": design_study.RATIO_LIMIT,
         "trials": {"complete": len(complete), "feasible": sum(map(design_study.feasible, complete)),
                    "failed": states.count(optuna.trial.TrialState.FAIL),
                    "running": states.count(optuna.trial.TrialState.RUNNING), **rate(complete)},
@@ -96,14 +94,13 @@ def plot(study, front, path: pathlib.Path) -> pathlib.Path:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from robostrich_suite.studies import design
     trials = design_study.complete_trials(study)
     fig, ax = plt.subplots(figsize=(7, 5))
     ok = [t for t in trials if design_study.feasible(t)]
     bad = [t for t in trials if not design_study.feasible(t)]
     if bad:
         ax.scatter([t.values[0] for t in bad], [100 * t.values[1] for t in bad], c="0.7", marker="x", s=18,
-                   label=f"rolling/lever > {design.RATIO_LIMIT} ({len(bad)})")
+                   label=f"rolling/lever > {design_study.RATIO_LIMIT} ({len(bad)})")
     if ok:
         points = ax.scatter([t.values[0] for t in ok], [100 * t.values[1] for t in ok], s=22, cmap="viridis",
                             c=[t.user_attrs["result"]["rolling_lever_ratio"] for t in ok],

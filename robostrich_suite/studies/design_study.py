@@ -4,7 +4,7 @@ A study is fixed to its :class:`Settings` (pose budget, searching the stiffness,
 scoring the way in, the tendons' counts and strides; its user attributes): trials scored otherwise do not compare, so resuming
 with others is refused.
 Each trial stores its measures as the user attribute ``result`` and the constraint
-(rolling/lever ratio minus ``design.RATIO_LIMIT``, feasible at <= 0) as the user attribute
+(rolling/lever ratio minus ``RATIO_LIMIT``, feasible at <= 0) as the user attribute
 ``constraint`` and as Optuna's own constraint, which the sampler reads.
 """
 from __future__ import annotations
@@ -16,6 +16,16 @@ import pathlib
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.model import layouts as layouts_lib
 from robostrich_suite.studies import design_objectives, design_space
+
+RATIO_LIMIT = 0.6  # rolling / lever attitude ratio a routing must not pass (design.py's module doc)
+OBJECTIVES = ("coverage", "gap_column_m")  # both maximised
+PASSAGE_OBJECTIVES = ("coverage", "gap_passage_m")  # with --score-passage
+HEARTBEAT_S, GRACE_S = 30, 120  # a trial silent this long was on a machine that died: failed
+FRONT_LAYOUTS = 10  # the front's routings written as layout files, best gap column first
+
+
+def objectives(score_passage: bool) -> tuple:
+    return PASSAGE_OBJECTIVES if score_passage else OBJECTIVES
 
 MAX_RATIO = 1e3  # a routing whose lever hardly turns the head: the ratio is "huge", kept finite
 
@@ -75,17 +85,16 @@ def open_study(url: str, name: str, settings: Settings, seed: int):
     of other :class:`Settings`.  The sampler's seed is offset by the trials it holds, so a resumed study
     does not draw its first routings again."""
     optuna = _optuna()
-    from robostrich_suite.studies import design
     try:
-        storage = optuna.storages.RDBStorage(url, heartbeat_interval=design.HEARTBEAT_S,
-                                             grace_period=design.GRACE_S)
+        storage = optuna.storages.RDBStorage(url, heartbeat_interval=HEARTBEAT_S,
+                                             grace_period=GRACE_S)
     except Exception as error:  # SQLAlchemy's URL, driver and connection errors have no common base
         if isinstance(error, (KeyboardInterrupt, SystemExit)):
             raise
         raise ValueError(f"--storage {redacted(url)}: {type(error).__name__}: {error}") from None
     study = optuna.create_study(storage=storage, study_name=name, load_if_exists=True,
-                                directions=["maximize"] * len(design.OBJECTIVES))
-    if list(study.directions) != [optuna.study.StudyDirection.MAXIMIZE] * len(design.OBJECTIVES):
+                                directions=["maximize"] * len(OBJECTIVES))
+    if list(study.directions) != [optuna.study.StudyDirection.MAXIMIZE] * len(OBJECTIVES):
         raise ValueError(f"study {name!r} in {redacted(url)} is not a robostrich-design study")
     if not study.user_attrs:
         for key, value in settings.attrs().items():
@@ -135,7 +144,6 @@ def complete_trials(study) -> list:
 
 
 def objective(settings: Settings):
-    from robostrich_suite.studies import design
     budget = design_objectives.Budget(poses=settings.pose_budget)
 
     def score(trial):
@@ -146,9 +154,9 @@ def objective(settings: Settings):
         ratio = MAX_RATIO if ratio is None or not math.isfinite(ratio) else min(ratio, MAX_RATIO)
         result["rolling_lever_ratio"] = ratio
         trial.set_user_attr("result", result)
-        trial.set_user_attr("constraint", ratio - design.RATIO_LIMIT)
-        trial.set_constraint("rolling_lever_ratio", ratio - design.RATIO_LIMIT)
-        return tuple(result[name] for name in design.objectives(settings.score_passage))
+        trial.set_user_attr("constraint", ratio - RATIO_LIMIT)
+        trial.set_constraint("rolling_lever_ratio", ratio - RATIO_LIMIT)
+        return tuple(result[name] for name in objectives(settings.score_passage))
     return score
 
 
