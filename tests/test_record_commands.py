@@ -62,3 +62,22 @@ def test_the_earlier_main_jobs_resolve_to_their_own_settings_not_todays():
         assert sum(lesson.steps for lesson in plan) == 600_000, name
         assert config == dataclasses.replace(main_job.MAIN_JOB_SAC, **fine), name
         assert config != today
+
+
+LIST_TARGET_RECORDS = ("antagonist_pairs", "main_job", "main_job_600k", "main_job_plain_inputs")  # before 2026-12-07
+
+
+def test_records_made_before_targets_between_the_stored_poses_train_on_the_list(tmp_path):
+    """The main job trains on targets between the stored poses since 2026-12-07; the records made
+    before keep their list of targets by their commands' flag, for ours and the peers alike."""
+    from agents.robostrich.domains import Domain
+    assert main_job.resolve_task_kwargs({}, Domain("robostrich"))["target_between"] == 4
+    assert "target_between" not in main_job.resolve_task_kwargs({}, Domain("robostrich_a1"))
+    for name in LIST_TARGET_RECORDS:
+        _, passthrough = sweep.build_parser().parse_known_args(_arguments(name))
+        args = training.build_parser().parse_args(passthrough)
+        assert main_job.resolve_task_kwargs(args.task_kwargs, Domain("robostrich"))["target_between"] == 0, name
+    for name in PEER_RECORDS:
+        args = benchmark_peers.build_parser().parse_args([*_arguments(name), "--out", str(tmp_path)])
+        settings = benchmark_peers.settings_from(args)
+        assert settings.task_kwargs == {"target_between": 0}, name

@@ -254,12 +254,12 @@ def test_main_job_defaults_train_the_recipe_on_the_arm_and_plain_sac_settings_el
         Domain("robostrich", "paper")
     recipe = {"weights": {"position_precision": 1.0, "attitude_precision": 0.5}, "target_sampling": "failures",
               "fixed_stored_starts": 0.25}
-    assert main_job.resolve_task_kwargs({}, arm) == recipe
+    assert main_job.resolve_task_kwargs({}, arm) == {**recipe, "target_between": 4}  # on the frame
     assert main_job.resolve_task_kwargs({"weights": {"position_error": 10}, "position_tolerance": 0.02}, arm) == {
         **recipe, "weights": {"position_precision": 1.0, "attitude_precision": 0.5, "position_error": 10},
-        "position_tolerance": 0.02}
+        "position_tolerance": 0.02, "target_between": 4}
     paper = {"weights": {"position_precision": 0, "attitude_precision": 0}, "target_sampling": "uniform",
-             "fixed_stored_starts": 0}
+             "fixed_stored_starts": 0, "target_between": 0}
     assert main_job.resolve_task_kwargs(paper, arm) == paper
     # the standing quadruped's arm holds the frame's stored poses: the same recipe there, and a
     # quarter of lesson 4's episodes stand

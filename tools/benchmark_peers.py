@@ -24,6 +24,7 @@ import shlex
 import sys
 
 from agents.robostrich.peers import sbx_agents as peers  # needs no sbx to import
+from agents.robostrich.train.checks import json_object
 
 PROG = "benchmark_peers"
 AGENTS = ("curriculum", "plain", *peers.PEERS)
@@ -64,6 +65,10 @@ def build_parser():
     p.add_argument("--ours-args", default="",
                    help="robostrich-train flags our two runs take besides the main job's, e.g. "
                         "--ours-args='--fine-input-gain 0' for the main job before fine inputs (default: none)")
+    p.add_argument("--task-kwargs", type=json_object, default={},
+                   help="JSON object of task options every agent trains with, over the main job's (robostrich-train "
+                        "--task-kwargs), e.g. '{\"target_between\": 0}' for the main job's list of targets before "
+                        "2026-12-07 (default: none)")
     p.add_argument("--record-only", action="store_true",
                    help="train nothing: write the record from the runs finished in --out so far (the others are "
                         "named as unfinished), e.g. after the command was stopped")
@@ -90,7 +95,7 @@ def settings_from(args):
     return bench.Settings(steps=args.steps, seeds=args.seeds, agents=args.agents, ways=args.ways, out=args.out,
                           eval_every=args.eval_every or max(1, args.steps // 10),
                           num_eval_targets=args.num_eval_targets, final_eval_targets=args.final_eval_targets,
-                          track_task=args.track_task or None, ours_args=ours_args)
+                          track_task=args.track_task or None, ours_args=ours_args, task_kwargs=args.task_kwargs)
 
 
 def main(argv=None) -> int:

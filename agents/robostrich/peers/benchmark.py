@@ -41,6 +41,7 @@ class Settings:
     final_eval_targets: Optional[int]
     track_task: Optional[str]
     ours_args: tuple = ()  # robostrich-train flags our runs take besides the main job's
+    task_kwargs: dict = dataclasses.field(default_factory=dict)  # every agent's, over the main job's
 
 
 def lesson_plan(way: str, steps: int) -> tuple:
@@ -67,7 +68,7 @@ def peer_spec(settings: Settings, label: str, seed: int) -> peers.PeerSpec:
     agent, way = label.rsplit("_", 1)
     domain = Domain(DOMAIN)
     return peers.PeerSpec(agent, way, seed, lesson_plan(way, settings.steps),
-                          main_job.resolve_task_kwargs({}, domain), main_job.resolve_layout(None, domain),
+                          main_job.resolve_task_kwargs(settings.task_kwargs, domain), main_job.resolve_layout(None, domain),
                           domain.heldout_task("lesson3"), settings.track_task, eval_points(settings),
                           settings.num_eval_targets, settings.final_eval_targets, job_dir(settings, label, seed))
 
@@ -81,6 +82,8 @@ def ours_argv(settings: Settings, label: str, seed: int) -> list:
             "--num-eval-targets", str(settings.num_eval_targets), "--track-task", settings.track_task or ""]
     if settings.final_eval_targets:
         argv += ["--final-eval-targets", str(settings.final_eval_targets)]
+    if settings.task_kwargs:
+        argv += ["--task-kwargs", json.dumps(settings.task_kwargs)]
     return argv + list(settings.ours_args)
 
 

@@ -24,6 +24,7 @@ from agents.robostrich.evaluate import command as evaluate_command
 from agents.robostrich.evaluate import evaluation
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.robostrich.train.main_job import (DEFAULT_ARM_LAYOUT, DEFAULT_ARM_TASK_KWARGS, DEFAULT_TOTAL_STEPS,
+                                              FRAME_TASK_KWARGS,
                                         MAIN_JOB_BY_DOMAIN, MAIN_JOB_LESSON_SHARES, MAIN_JOB_SAC, MAIN_JOB_STEPS,
                                         QUADRUPED_TASK_KWARGS, positive_int)
 from agents.robostrich.train.run_directory import check_run_directory, finished_summary, lock_run_directory, previous_init_path
@@ -70,12 +71,13 @@ def _add_run_arguments(run) -> None:
     run.add_argument("--task-kwargs", type=json_object, default={},
                      help="JSON object passed to every training lesson's task, e.g. eq. 10's weights: "
                           "'{\"weights\": {\"position_error\": 10}}' (evaluation keeps the task's defaults). On the "
-                          f"arm domains it goes over {json.dumps(DEFAULT_ARM_TASK_KWARGS)}, on robostrich_a1 also "
-                          f"{json.dumps(QUADRUPED_TASK_KWARGS)} (weights merged key by key; "
+                          f"arm domains it goes over {json.dumps(DEFAULT_ARM_TASK_KWARGS)}, on robostrich also "
+                          f"{json.dumps(FRAME_TASK_KWARGS)}, on robostrich_a1 {json.dumps(QUADRUPED_TASK_KWARGS)} "
+                          "(weights merged key by key; "
                           "'{\"weights\": {\"position_precision\": 0, \"attitude_precision\": 0}, "
                           "\"target_sampling\": \"uniform\", "
-                          "\"fixed_stored_starts\": 0}' gives the paper's eq. 10, its uniform draw of targets and "
-                          "its fixed starts in lessons 1-2)")
+                          "\"fixed_stored_starts\": 0, \"target_between\": 0}' gives the paper's eq. 10, its "
+                          "uniform draw of the stored targets and its fixed starts in lessons 1-2)")
     run.add_argument("--randomize", type=randomize_scales, default=None, metavar="FAMILY=S,...",
                      help="train across robots that differ from the model: each episode draws each family's "
                           "scale from [0, S] (families and scales as robostrich-robustness measures them, "

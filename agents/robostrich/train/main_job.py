@@ -57,14 +57,21 @@ DEFAULT_ARM_LAYOUT = layouts.DEFAULT
 # Gaussian term for the head's attitude (1 deg scale), which holds the head level well inside the
 # 5 deg tolerance (docs/log/learning.md#the-attitude-precision-term-becomes-the-default-24-of-24-track-targets-2026-12-01
 # and the sections below it). '{"weights": {"position_precision": 0, "attitude_precision": 0},
-# "target_sampling": "uniform", "fixed_stored_starts": 0}' gives the paper's eq. 10, draw and
-# starts. Evaluation keeps the task's defaults.
+# "target_sampling": "uniform", "fixed_stored_starts": 0, "target_between": 0}' gives the paper's
+# eq. 10, draw and starts. Evaluation keeps the task's defaults.
 DEFAULT_ARM_TASK_KWARGS = {"weights": {"position_precision": 1.0, "attitude_precision": 0.5},
                            "target_sampling": "failures", "fixed_stored_starts": 0.25}
 # The same with lessons 1-2 starting fixed, for arms whose stored poses (a layout's lookup table)
 # are not shipped: the candidate arms of robostrich-layouts --train.
 FIXED_START_ARM_TASK_KWARGS = {**DEFAULT_ARM_TASK_KWARGS, "fixed_stored_starts": 0.0}
 
+
+# On the frame each drawn training target also moves a uniform share of the way towards one of its 4
+# nearest stored poses (Reach target_between), so that training meets the level poses between the
+# stored ones, where a researcher's own targets lie, not only the list
+# (docs/log/learning.md#targets-between-the-stored-poses-adopted-2026-12-07). Not measured on the
+# quadruped, which keeps the list.
+FRAME_TASK_KWARGS = {"target_between": 4}
 
 # On the quadruped a quarter of lesson 4's episodes stand (the standing lessons rehearsed): trained
 # on trotting alone, the policy could lose standing targets it had held after lesson 3
@@ -76,11 +83,12 @@ positive_int = cli_lib.whole_number(1, MAX_TOTAL_STEPS)  # control steps
 
 
 def default_task_kwargs(domain: Domain) -> dict:
-    """The main job's task arguments on `domain` (none off the arm): the same on the frame and on
-    the quadruped, where the arm holds the stored poses as on the frame, plus lesson 4's rehearsal."""
+    """The main job's task arguments on `domain` (none off the arm): the arm's on the frame and on
+    the quadruped, where the arm holds the stored poses as on the frame; then targets between the
+    stored poses on the frame, lesson 4's rehearsal on the quadruped."""
     if not domain.is_arm:
         return {}
-    return {**DEFAULT_ARM_TASK_KWARGS, **(QUADRUPED_TASK_KWARGS if domain.on_quadruped else {})}
+    return {**DEFAULT_ARM_TASK_KWARGS, **(QUADRUPED_TASK_KWARGS if domain.on_quadruped else FRAME_TASK_KWARGS)}
 
 
 def resolve_layout(layout: Optional[str], domain: Domain) -> Optional[str]:
