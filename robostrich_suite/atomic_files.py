@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import json
 import os
 import pathlib
 import tempfile
@@ -72,6 +73,20 @@ def naming(path, only_unnamed: bool = False):
 def write_text(path, text: str) -> None:
     with replaced_atomically(path, "w") as handle:
         handle.write(text)
+
+
+def write_json(path, obj) -> None:
+    """``obj`` as JSON (numpy numbers and arrays as plain ones), written whole or not at all."""
+    write_text(path, json.dumps(obj, indent=1, default=_plain_json))
+
+
+def _plain_json(value):
+    import numpy as np
+    if isinstance(value, (np.floating, np.integer)):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"not JSON serialisable: {type(value)}")
 
 
 def save_figure(fig, path, **savefig_kwargs) -> pathlib.Path:

@@ -101,8 +101,8 @@ def settings_from(args):
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     peers.require()  # before a minute of building: the one line says which extra
-    from agents.robostrich.evaluate import evaluation
     from agents.robostrich.peers import benchmark as bench
+    from robostrich_suite import atomic_files
     from agents.robostrich.peers import record as peers_record
     settings = settings_from(args)
     results = bench.run_all(settings, args.workers, say=lambda line: print(f"{PROG}: {line}", flush=True),
@@ -111,7 +111,7 @@ def main(argv=None) -> int:
         raise ValueError(f"--record-only: {args.out} holds no finished run of these settings")
     command = shlex.join(["python", "tools/benchmark_peers.py", *(sys.argv[1:] if argv is None else argv)])
     data = peers_record.record(settings, results, command)
-    evaluation.write_json(os.path.join(args.out, "peers.json"), data)
+    atomic_files.write_json(os.path.join(args.out, "peers.json"), data)
     peers_record.plot(data, os.path.join(args.out, "learning_curves.png"))
     import results_peers
     table = "\n".join(results_peers.full(data)) + "\n"

@@ -94,11 +94,10 @@ def markdown(rows) -> str:
 
 def main(argv=None):
     args = build_parser().parse_args(argv)
-    from agents.robostrich.evaluate import evaluation
     from robostrich_suite import atomic_files
     rows = measure(args.errors, args.every, args.draws, args.seed)
     os.makedirs(args.out, exist_ok=True)
-    evaluation.write_json(os.path.join(args.out, "sensitivity.json"), rows)
+    atomic_files.write_json(os.path.join(args.out, "sensitivity.json"), rows)
     atomic_files.write_text(os.path.join(args.out, "sensitivity.md"), markdown(rows))
     print(markdown(rows), end="")
     return 0

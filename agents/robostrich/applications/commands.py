@@ -18,11 +18,10 @@ from agents.robostrich.applications import figures as application_figures
 from agents.robostrich.applications import rollouts as applications
 from agents.robostrich.applications import narrow_gap as gap
 from agents.robostrich.applications import stabilization
-from agents.robostrich.evaluate.evaluation import write_json
 from agents.robostrich.applications.stabilization import GOALS
 from robostrich_suite import outputs, progress, web_viewer
 from robostrich_suite import cli as cli_lib
-from robostrich_suite.atomic_files import write_text
+from robostrich_suite import atomic_files
 from robostrich_suite.tasks import quadruped_tasks
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
 
@@ -77,9 +76,9 @@ def _meta(args, task: str, policies) -> dict:
 def _write(out: str, name: str, report: dict, series: dict, table: str) -> list:
     paths = [os.path.join(out, f"{name}_report.json"), os.path.join(out, f"{name}_series.json"),
              os.path.join(out, f"{name}_summary.txt")]
-    write_json(paths[0], report)
-    write_json(paths[1], series)
-    write_text(paths[2], table)
+    atomic_files.write_json(paths[0], report)
+    atomic_files.write_json(paths[1], series)
+    atomic_files.write_text(paths[2], table)
     return paths
 
 

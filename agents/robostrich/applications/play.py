@@ -17,9 +17,9 @@ from agents.robostrich.applications import figures as application_figures
 from agents.robostrich.applications import rollouts as applications
 from agents.robostrich.evaluate import evaluation
 from agents.robostrich.applications import stabilization
-from agents.robostrich.domains import as_domain, domain_of, TRACK_TASK
+from agents.robostrich.domains import domain_of, TRACK_TASK
 from agents.robostrich.recording import open_recorder
-from robostrich_suite import outputs, policies, web_viewer
+from robostrich_suite import atomic_files, outputs, policies, web_viewer
 from robostrich_suite import cli as cli_lib
 
 def policy_label(policy: str) -> str:
@@ -89,7 +89,7 @@ def main(argv=None) -> dict:
     reports[second], written = play(policy, domain, args, label)
     for kind, report in reports.items():
         report.update(label=label, policy=args.policy)
-        evaluation.write_json(os.path.join(args.out, f"{label}_{kind}.json"), report)
+        atomic_files.write_json(os.path.join(args.out, f"{label}_{kind}.json"), report)
     print(f"wrote {args.out}/: reports, {', '.join(written)}", flush=True)
     if args.web:
         web_viewer.serve([os.path.join(args.out, name) for name in written if name.endswith(".rrd")], args.web_port)

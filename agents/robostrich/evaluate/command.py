@@ -18,11 +18,11 @@ from agents.robostrich.domains import as_domain
 from agents.robostrich.evaluate.evaluation import (MAX_TARGETS, check_heldout_task, check_track_task,
                                                     checked_fingerprint, checkpoint_domain, default_heldout_task,
                                                     episode_count, evaluate_agent, evaluate_lookup,
-                                                    load_run_from_checkpoint, summary_lines, target_count, write_json)
+                                                    load_run_from_checkpoint, summary_lines, target_count)
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.sac.builder import SACBuilder
 from robostrich_suite import cli as cli_lib
-from robostrich_suite import outputs, web_viewer
+from robostrich_suite import atomic_files, outputs, web_viewer
 from robostrich_suite import progress as progress_lib
 from robostrich_suite.studies import new_targets as new_targets_lib
 
@@ -118,7 +118,7 @@ def main(argv=None):
         figures.plot_track({label: r["track"] for label, r in reports.items()},
                            os.path.join(out, f"{args.label}_track.png"))
     summary = {label: {kind: r["summary"] for kind, r in rs.items()} for label, rs in reports.items()}
-    write_json(os.path.join(out, "summary.json"), summary)
+    atomic_files.write_json(os.path.join(out, "summary.json"), summary)
     print("\n".join(summary_lines(summary)), flush=True)
     print(f"wrote {out}/: summary.json, reports" + ("" if args.no_figures or "track" not in reports[args.label]
                                                     else f", {args.label}_track.png"), flush=True)

@@ -8,7 +8,6 @@ one of the three starts in turn; robostrich_suite/studies/new_targets.py), and t
 domains report episode returns. Writes one JSON report per evaluation; a checkpoint's run is rebuilt here too (`load_run_from_checkpoint`). The
 command `robostrich-evaluate` is agents/robostrich/evaluate/command.py.
 """
-import json
 import os
 import shutil
 import tempfile
@@ -37,9 +36,11 @@ KIND_NAMES = {"heldout": "held-out, fixed start", "heldout_moving": "held-out, m
               "new": "new targets, fixed start", "new_moving": "new targets, moving starts", "track": "track"}
 
 
-def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dict:
+def rollout(env, actor, flattener, on_step=None, action_repeat: int = 1) -> dict:
     """One episode with `actor` (acting every `action_repeat` control steps); per-control-step series
-    of the task's measurement (robostrich_suite/tasks/measurement.py), read once per step."""
+    of the task's measurement (robostrich_suite/tasks/measurement.py), read once per step.
+    ``on_step(env, action, timestep, measured)``, if given, sees every step as it happens (a
+    recording's ``log_step``; action None at the reset)."""
     timestep = env.reset()
     physics = env.physics
     measured = measure(env)
@@ -48,8 +49,8 @@ def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dic
                               "target", "action", "reward")}
     # the task's own tolerances, not the paper's constants
     series["tolerances"] = [measured.position_tolerance, measured.attitude_tolerance]
-    if recorder is not None:
-        recorder.log_step(env, None, timestep, measured)
+    if on_step is not None:
+        on_step(env, None, timestep, measured)
     step = 0
     while not timestep.last():
         cli_lib.raise_if_interrupted()  # a Ctrl-C some library swallowed
@@ -67,8 +68,8 @@ def rollout(env, actor, flattener, recorder=None, action_repeat: int = 1) -> dic
             series["head_position"].append(measured.head_position.tolist())
             series["head_attitude"].append(measured.head_attitude)
             series["target"].append(measured.target.tolist())
-        if recorder is not None:
-            recorder.log_step(env, action, timestep, measured)
+        if on_step is not None:
+            on_step(env, action, timestep, measured)
     return series
 
 
@@ -241,7 +242,8 @@ def evaluate_track(actor, flattener, domain="robostrich", task: str = "track", s
                    recorder=None, action_repeat: int = 1) -> dict:
     """The `track` task: targets in order (Fig. 7); one summary per target segment plus the series."""
     env = make_environment(domain, task, seed)
-    series = rollout(env, actor, flattener, recorder=recorder, action_repeat=action_repeat)
+    series = rollout(env, actor, flattener, recorder.log_step if recorder is not None else None,
+                     action_repeat=action_repeat)
     segments = []
     targets = series["target"]
     bounds = [0] + [i for i in range(1, len(targets)) if targets[i] != targets[i - 1]] + [len(series["time"])]
@@ -282,7 +284,7 @@ def evaluate_agent(actor, flattener, out_dir: str, label: str, domain, heldout_t
             on_episode()
     for kind, report in reports.items():
         report.update(label=label, env_steps=env_steps)
-        write_json(os.path.join(out_dir, f"{label}_{kind}.json"), report)
+        atomic_files.write_json(os.path.join(out_dir, f"{label}_{kind}.json"), report)
     return reports
 
 
@@ -361,19 +363,6 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
     lookup_cache.keep(digest, out_dir, [f"{LABEL}_{kind}.json" for kind in reports]
                       + ([f"{LABEL}_track.rrd"] if record and "track" in reports else []))
     return reports
-
-
-def write_json(path: str, obj) -> None:
-    """``obj`` as JSON, written whole or not at all (robostrich_suite.atomic_files)."""
-    atomic_files.write_text(path, json.dumps(obj, indent=1, default=_json_default))
-
-
-def _json_default(o):
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError(f"not JSON serialisable: {type(o)}")
 
 
 def checked_fingerprint(path: str) -> dict:

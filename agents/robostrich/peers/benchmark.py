@@ -12,14 +12,12 @@ import os
 import shutil
 from typing import Optional
 
-import numpy as np
-
 from agents.curriculum import Lesson, read_records
-from agents.robostrich.evaluate import evaluation
 from agents.robostrich.train import main_job
 from agents.robostrich.peers import sbx_agents as peers
 from agents.robostrich.train import command as training
 from agents.robostrich.domains import Domain
+from robostrich_suite import atomic_files
 
 DOMAIN = "robostrich"
 OURS = {"curriculum": "curriculum SAC (ours)", "plain": "plain SAC (ours, final lesson only)"}
@@ -125,7 +123,7 @@ def run_job(settings: Settings, label: str, seed: int) -> dict:
     result = run_ours(settings, label, seed) if label in OURS else peers.train(peer_spec(settings, label, seed))
     result["final"] = {kind: compact(s) for kind, s in result["final"].items()}
     result["curve"] = [[r["env_steps"], r["summary"]["success_rate"]] for r in result["curve"]]
-    evaluation.write_json(os.path.join(out, "result.json"), result)
+    atomic_files.write_json(os.path.join(out, "result.json"), result)
     return result
 
 

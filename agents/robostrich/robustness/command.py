@@ -21,7 +21,7 @@ from agents.robostrich.robustness import figure as robustness_figure
 from agents.robostrich.domains import as_domain, Domain, domain_of
 from agents.robostrich.lookup import LABEL, LookupPolicy
 from agents.sac.builder import SACBuilder
-from robostrich_suite import outputs, policies
+from robostrich_suite import atomic_files, outputs, policies
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.tasks import perturbations
 
@@ -245,7 +245,7 @@ def main(argv=None) -> dict:
     _check_out(args.out)
     results = measure(evaluated, domain, args.scales, args.num_targets, progress=not args.no_progress)
     report = summary(args, evaluated, results, domain)
-    evaluation.write_json(os.path.join(args.out, "robustness.json"), report)
+    atomic_files.write_json(os.path.join(args.out, "robustness.json"), report)
     robustness_figure.plot(report, os.path.join(args.out, "robustness.png"))
     print("\n".join(summary_lines(report)), flush=True)
     print(f"wrote {args.out}/robustness.json, robustness.png", flush=True)

@@ -4,7 +4,6 @@ the Markdown tables of it (the sweep's table, and every evaluation row by row).
 ``aggregate`` is what the committed records in docs/results/ keep (tools/results_page.py), so its
 output keeps its shape: ``{"seeds", "minutes", "steps", "results": {label: {kind: {metric: stats}}}}``.
 """
-import json
 import os
 import shlex
 

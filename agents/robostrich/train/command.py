@@ -35,7 +35,7 @@ from agents.robostrich.train.jobs import LookupSpec, RunJob, RunSpec, step_bound
 from agents.robostrich.train.progress import Progress
 from agents.robostrich.train.workers import train_in_parallel
 from robostrich_suite import cli as cli_lib
-from robostrich_suite import outputs
+from robostrich_suite import atomic_files, outputs
 
 
 def _add_run_arguments(run) -> None:
@@ -206,7 +206,7 @@ def start_runs(args, argv, setup: TrainingSetup, init: dict):
             for p in (metrics_path, evals_path):
                 if os.path.exists(p):
                     os.unlink(p)
-    evaluation.write_json(os.path.join(args.out, "config.json"), {
+    atomic_files.write_json(os.path.join(args.out, "config.json"), {
         "argv": sys.argv if argv is None else list(argv), "config": setup.config.to_dict(),
         "lessons": setup.lessons.to_dict(), "residual_scale": setup.residual_scale,
         "task_kwargs": args.task_kwargs, "layout": args.layout,
@@ -272,7 +272,7 @@ def report(args, setup: TrainingSetup, specs: dict, outcomes: dict, lookup) -> d
                "env_steps": {label: o["env_steps"] for label, o in outcomes.items()},
                "updates": {label: o["updates"] for label, o in outcomes.items()},
                "timings": {label: o["timing"] for label, o in outcomes.items() if o["timing"]}}
-    evaluation.write_json(os.path.join(args.out, "summary.json"), summary)
+    atomic_files.write_json(os.path.join(args.out, "summary.json"), summary)
     print_summary(args.out, summary)
     return summary
 
