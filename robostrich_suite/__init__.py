@@ -57,6 +57,7 @@ except (ImportError, AttributeError, OSError) as _error:
     raise
 
 from robostrich_suite.policies import load_policy  # noqa: E402,F401  (a shipped trained policy)
+from robostrich_suite.model import layouts
 
 _DOMAINS = collections.OrderedDict([("robostrich", robostrich), ("robostrich_a1", robostrich_a1)])
 
@@ -114,7 +115,6 @@ def load(domain_name, task_name, task_kwargs=None, environment_kwargs=None, visu
         raise TypeError(f"task_kwargs must be a dict of the task's options, got {type(task_kwargs).__name__}")
     task_kwargs = dict(task_kwargs or {})
     if isinstance(task_kwargs.get("tendon_layout"), str):  # a built-in layout by name, or a layout file
-        from robostrich_suite.model import layouts
         try:
             name = task_kwargs["tendon_layout"]
             task_kwargs["tendon_layout"] = (layouts.read_file(name)[1] if name.lower().endswith((".json", ".toml"))

@@ -41,6 +41,7 @@ from gymnasium import spaces
 
 import robostrich_suite
 from robostrich_suite.tasks import measurement
+from robostrich_suite.tasks.actions import validate_action
 
 
 class GymnasiumEnv(gymnasium.Env):
@@ -106,7 +107,6 @@ class GymnasiumEnv(gymnasium.Env):
 
     def to_dm_action(self, action) -> np.ndarray:
         """The dm_env action (contractions in metres) for a gymnasium action."""
-        from robostrich_suite.tasks.actions import validate_action
         action = validate_action(action, self._action_low.size)
         if not self.normalize_actions:
             return action

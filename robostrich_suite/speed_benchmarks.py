@@ -9,6 +9,7 @@ import time
 import numpy as np
 
 import robostrich_suite
+from robostrich_suite import atomic_files
 
 
 class EnvLoop:
@@ -75,7 +76,6 @@ def ratio(what: str, value: float, low: float = None, high: float = None) -> dic
 def write_report(path, script: str, argv: list, description: str, rates: list, ratios: list) -> None:
     """A speed benchmark's ``--json`` file: what ``tools/results_page.py add`` records (kind "speed"),
     with the command that made it."""
-    from robostrich_suite import atomic_files
     command = shlex.join(["python", f"tools/{os.path.basename(script)}", *argv])
     atomic_files.write_text(path, json.dumps({"benchmark": "speed", "command": command, "description": description,
                                        "rates": rates, "ratios": ratios}, indent=1) + "\n")

@@ -25,6 +25,7 @@ import sys
 import tempfile
 import time
 import urllib.parse
+from robostrich_suite import cli as cli_lib
 
 HOST = "127.0.0.1"
 DEFAULT_PORT = 9090  # the port Rerun's own web viewer uses
@@ -33,7 +34,6 @@ START_TIMEOUT = 60.0  # s for the servers to listen: the rerun program is large 
 
 
 def add_flags(parser: argparse.ArgumentParser) -> None:
-    from robostrich_suite import cli as cli_lib
     parser.add_argument("--web", action="store_true",
                         help=f"then serve the .rrd recordings in Rerun's web viewer at http://{HOST}:PORT "
                              "until Ctrl-C (no display or native viewer needed)")

@@ -12,15 +12,15 @@ import pathlib
 from robostrich_suite import atomic_files
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import outputs
+from robostrich_suite import robostrich
+from robostrich_suite import robostrich_a1
 
 
 def _robostrich():
-    from robostrich_suite import robostrich
     return robostrich.get_model_and_assets()[0]
 
 
 def _robostrich_a1():
-    from robostrich_suite import robostrich_a1
     return robostrich_a1.get_model_and_assets()[0]
 
 

@@ -204,3 +204,27 @@ def test_no_two_modules_import_each_other_even_inside_functions():
                                for a in node.names)
         graph[module] = {t for t in targets if t in found and t != module}
     assert import_circles(graph) == []
+
+
+# The project's own modules a function may import instead of its module, and why.
+FUNCTION_LEVEL_IMPORTS = {
+    ("agents/robostrich/peers/sbx_agents.py", "robostrich_suite.gym_adapter"):
+        "gymnasium, which the adapter needs, comes with the optional sbx extra only",
+}
+
+
+def test_the_projects_own_modules_are_imported_at_the_top_of_a_module():
+    """A module's imports at its top say what it needs; a function-level import of the project's
+    own code hides a dependency (and once hid an import circle), so only the listed ones stay."""
+    found = set()
+    for package in ("robostrich_suite", "agents", "tools"):
+        for path in sorted((ROOT / package).rglob("*.py")):
+            for function in ast.walk(ast.parse(path.read_text())):
+                if not isinstance(function, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                    continue
+                for node in ast.walk(function):
+                    names = ([node.module] if isinstance(node, ast.ImportFrom) and node.module else
+                             [a.name for a in node.names] if isinstance(node, ast.Import) else [])
+                    found.update((str(path.relative_to(ROOT)), name) for name in names
+                                 if name.split(".")[0] in ("robostrich_suite", "agents"))
+    assert found == set(FUNCTION_LEVEL_IMPORTS), sorted(found - set(FUNCTION_LEVEL_IMPORTS))

@@ -15,6 +15,11 @@ import os
 import sys
 import time
 from collections import deque
+from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.evaluate import evaluation
+from agents.robostrich.train.main_job import MAIN_JOB_SAC  # robostrich-train's agent, these flags on top
+from agents.sac.builder import SACBuilder
+from robostrich_suite.atomic_files import write_text  # the project's one atomic writer
 
 # PlaNet's action repeats, used by the state-SAC baselines of CURL/DrQ; budgets are this tool's defaults.
 ACTION_REPEAT = {"reacher/easy": 4, "cartpole/swingup": 8, "cheetah/run": 4, "finger/spin": 2,
@@ -133,15 +138,11 @@ def format_table(rows) -> str:
 
 
 def write_atomic(path: str, text: str) -> None:
-    from robostrich_suite.atomic_files import write_text  # the project's one atomic writer
     write_text(path, text)
 
 
 def train_and_evaluate(task, seed, steps, eval_at, config, args, progress, on_row):
     """One SAC run on `task`; `on_row(row)` after each deterministic evaluation."""
-    from agents.robostrich.evaluate import evaluation
-    from agents.robostrich.domain_run import DomainRun, parse_plan
-    from agents.sac.builder import SACBuilder
     domain, task_name = task.split("/")
     run_dir = os.path.join(args.out, task.replace("/", "_"), f"seed_{seed}")
     run = DomainRun(parse_plan(f"{task}:{steps}"), config, seed, run_dir, checkpoint_every=steps, name=task)
@@ -178,7 +179,6 @@ def main(argv=None) -> int:
             raise ValueError("--eval-episodes must be positive")
         settings = {t: task_settings(args, t) for t in tasks}
         import dataclasses
-        from agents.robostrich.train.main_job import MAIN_JOB_SAC  # robostrich-train's agent, these flags on top
         configs = {t: dataclasses.replace(MAIN_JOB_SAC, batch_size=args.batch_size, learning_rate=args.learning_rate,
                                           hidden_sizes=tuple(int(h) for h in args.hidden_sizes.split(",") if h),
                                           min_replay_size=args.min_replay_size, updates_per_call=args.updates_per_call,

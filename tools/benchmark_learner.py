@@ -31,6 +31,7 @@ from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from agents.sac.learning import SACLearner, Transitions, init_state
 from agents.sac.networks import make_networks
+from robostrich_suite import speed_benchmarks
 
 
 def plain_sac(networks, config):
@@ -215,7 +216,6 @@ def main(argv=None):
     print(f"training throughput estimate (action repeat {args.action_repeat}, {ud:g} update per transition): "
           f"{1.0 / per_step:.0f} control steps/s")
     if args.json:
-        from robostrich_suite import speed_benchmarks
         speed_benchmarks.write_report(
             args.json, __file__, argv if argv is not None else sys.argv[1:],
             f"the learner's jitted update ({config.hidden_sizes} networks, batch {config.batch_size}, "

@@ -25,6 +25,12 @@ import sys
 
 from agents.robostrich.peers import sbx_agents as peers  # needs no sbx to import
 from agents.robostrich.train.checks import json_object
+from agents.robostrich.evaluate import evaluation
+from agents.robostrich.peers import benchmark as bench
+from agents.robostrich.peers import record as peers_record
+from robostrich_suite import atomic_files
+from robostrich_suite import cli as cli_lib
+from robostrich_suite import outputs
 
 PROG = "benchmark_peers"
 AGENTS = ("curriculum", "plain", *peers.PEERS)
@@ -41,8 +47,6 @@ def _names(allowed):
 
 
 def build_parser():
-    from robostrich_suite import cli as cli_lib
-    from agents.robostrich.evaluate import evaluation
     p = argparse.ArgumentParser(prog=PROG, description=__doc__.splitlines()[0], allow_abbrev=False)
     p.add_argument("--steps", type=cli_lib.whole_number(1, 100_000_000), default=100_000,
                    help="control steps of every run (default: %(default)s)")
@@ -76,7 +80,6 @@ def build_parser():
 
 
 def _names_int(text: str) -> tuple:
-    from robostrich_suite import cli as cli_lib
     try:
         seeds = tuple(dict.fromkeys(cli_lib.seed(s.strip()) for s in text.split(",") if s.strip()))
     except argparse.ArgumentTypeError as error:
@@ -87,8 +90,6 @@ def _names_int(text: str) -> tuple:
 
 
 def settings_from(args):
-    from agents.robostrich.peers import benchmark as bench
-    from robostrich_suite import outputs
     outputs.check_directory(args.out)
     ours_args = tuple(shlex.split(args.ours_args))
     bench.check_ours_args(ours_args)
@@ -101,9 +102,6 @@ def settings_from(args):
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     peers.require()  # before a minute of building: the one line says which extra
-    from agents.robostrich.peers import benchmark as bench
-    from robostrich_suite import atomic_files
-    from agents.robostrich.peers import record as peers_record
     settings = settings_from(args)
     results = bench.run_all(settings, args.workers, say=lambda line: print(f"{PROG}: {line}", flush=True),
                             train=not args.record_only)
@@ -123,7 +121,6 @@ def main(argv=None) -> int:
 
 def cli(argv=None) -> int:
     """``main`` with the module doc's exit statuses: a missing extra or bad input is one line, status 2."""
-    from robostrich_suite import cli as cli_lib
     try:
         return main(argv)
     except peers.MissingExtra as error:

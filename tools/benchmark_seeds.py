@@ -11,13 +11,13 @@ docs/results/ name this command. The aggregation lives in agents/robostrich/swee
 import sys
 
 from agents.robostrich.sweep.table import aggregate, format_table  # noqa: F401  (tests and older callers)
+from agents.robostrich.sweep import command as sweep
 
 DEFAULT_OUT = "runs/seeds"
 
 
 def main(argv=None) -> int:
     """robostrich-sweep's exit status: 0, 1 when a seed failed, 2 on a bad input, 130 on Ctrl-C."""
-    from agents.robostrich.sweep import command as sweep
     argv = list(sys.argv[1:] if argv is None else argv)
     if not any(a == "--out" or a.startswith("--out=") for a in argv):
         argv += ["--out", DEFAULT_OUT]

@@ -28,6 +28,13 @@ import os
 import numpy as np
 
 from robostrich_suite.studies.gap_column import SAMPLES_PER_CAPSULE  # points per capsule
+from robostrich_suite import targets
+from robostrich_suite.atomic_files import save_figure
+from robostrich_suite.atomic_files import write_text
+from robostrich_suite.model import layouts
+from robostrich_suite.studies import gap_column
+from robostrich_suite.tasks.starts import STORED_START_SETTLE_TIME, hold_before_episode
+import robostrich_suite
 
 LEVEL_TOLERANCE = 5.0  # deg, as the tasks' attitude tolerance
 AGREEMENT = 0.02  # m: poses "agree" up to the last neck point where 95 % of them lie within this of their mean
@@ -36,14 +43,11 @@ BARRIER_BAND = (0.48, 0.51)  # m above ground: just over the curled poses' highe
 
 def capsule_points(physics, geoms) -> np.ndarray:
     """(n, 2) (forward, up) points along every arm geom's axis, base to head, in the trunk frame."""
-    from robostrich_suite.studies import gap_column
     return gap_column.capsule_points(physics, geoms, lambda point: physics.to_trunk_frame(point)[[0, 2]])
 
 
 def hold_all(env, controls):
     """Head (forward, up), unwrapped attitude and neck points of every input held for 2 s."""
-    from robostrich_suite.studies import gap_column
-    from robostrich_suite.tasks.starts import STORED_START_SETTLE_TIME, hold_before_episode
     physics = env.physics
     geoms = gap_column.arm_geoms(physics)
     head, attitude, neck = [], [], []
@@ -86,8 +90,6 @@ def swept_heights(neck, mask, forward: float) -> list:
 def crossings(env, controls, start, goal, count, seed=0):
     """Ramp from curled to raised inputs over 1 s; per transition the rearmost x at which any
     neck point lies in BARRIER_BAND, and the rearmost of the goal pose itself."""
-    from robostrich_suite.studies import gap_column
-    from robostrich_suite.tasks.starts import STORED_START_SETTLE_TIME, hold_before_episode
     physics = env.physics
     geoms = gap_column.arm_geoms(physics)
     rng = np.random.default_rng(seed)
@@ -115,7 +117,6 @@ def plot(head, neck, masks, pivot_point, rows, mount, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from robostrich_suite.atomic_files import save_figure
     fig, axes = plt.subplots(1, 4, figsize=(20, 5.5), sharex=True, sharey=True)
     rng = np.random.default_rng(0)
     for ax, (name, mask) in zip(axes, masks.items()):
@@ -157,9 +158,6 @@ def main(argv=None):
     args = p.parse_args(argv)
     if not 1 <= args.transitions <= 200:
         p.error(f"--transitions must be 1-200, got {args.transitions}")
-    import robostrich_suite
-    from robostrich_suite import targets
-    from robostrich_suite.model import layouts
     layout = args.layout or layouts.DEFAULT
     kwargs = {} if layout == layouts.DEFAULT else layouts.task_kwargs(layout)
     env = robostrich_suite.load("robostrich_a1", "lesson2", task_kwargs=kwargs)
@@ -187,7 +185,6 @@ def main(argv=None):
         "curled_to_raised": [{"from": r["from"], "to": r["to"],
                               "rearmost_x_in_band_m": round(r["rearmost_x_in_band"], 3)} for r in rows],
     }
-    from robostrich_suite.atomic_files import write_text
     os.makedirs(args.out, exist_ok=True)
     write_text(os.path.join(args.out, "gap_kinematics.json"), json.dumps(summary, indent=1) + "\n")
     plot(head, neck, masks, pivot_point, rows, mount, os.path.join(args.out, "gap_kinematics.png"))

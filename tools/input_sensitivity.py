@@ -16,6 +16,10 @@ import os
 import sys
 
 import numpy as np
+from agents.robostrich.lookup import lookup_table, nearest
+from robostrich_suite import atomic_files
+from robostrich_suite import targets
+import robostrich_suite
 
 
 def _fractions(text: str):
@@ -41,9 +45,6 @@ def build_parser():
 
 def measure(errors, every: int = 4, draws: int = 3, seed: int = 0) -> list:
     """One row per error size: episodes, success rate, median and 90th-percentile errors."""
-    import robostrich_suite
-    from agents.robostrich.lookup import lookup_table, nearest
-    from robostrich_suite import targets
     from tqdm import tqdm
 
     if every < 1 or draws < 1:
@@ -94,7 +95,6 @@ def markdown(rows) -> str:
 
 def main(argv=None):
     args = build_parser().parse_args(argv)
-    from robostrich_suite import atomic_files
     rows = measure(args.errors, args.every, args.draws, args.seed)
     os.makedirs(args.out, exist_ok=True)
     atomic_files.write_json(os.path.join(args.out, "sensitivity.json"), rows)

@@ -1,6 +1,7 @@
 """Tables of a "layouts" results record: robostrich-layouts' comparison of tendon routings
 (its layouts.json), rendered with the command's own table so both read alike."""
 import json
+from robostrich_suite.studies import layout_compare
 
 ROW_NOISE = ("target_file",)  # where one run wrote its files: not a result
 
@@ -16,13 +17,11 @@ def read(data: dict, path: str) -> tuple:
 
 
 def caption(data: dict) -> str:
-    from robostrich_suite.studies import layout_compare
     text = layout_compare.describe_samples(data["blue_region"]).rstrip(".")
     return text[0].lower() + text[1:]  # it follows the command and date
 
 
 def full(data: dict) -> list:
-    from robostrich_suite.studies import layout_compare
     return layout_compare.markdown_table(data["rows"]).rstrip("\n").split("\n")
 
 

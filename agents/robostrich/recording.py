@@ -12,6 +12,7 @@ from typing import Dict, List, Optional
 
 import numpy as np
 import rerun as rr
+from robostrich_suite import rerun_blueprint, rerun_log
 
 
 def _point(vector) -> list:
@@ -25,7 +26,6 @@ class RolloutRecorder:
     half-written recording."""
 
     def __init__(self, path: str, name: str = "rollout", application_id: str = "robostrich"):
-        from robostrich_suite import rerun_log
         self.path = path
         self.file = rerun_log.RecordingFile(application_id, path, recording_id=name)
         self.rec = None  # the stream, once the `with` block opens it
@@ -36,7 +36,6 @@ class RolloutRecorder:
 
     def _log_arm(self, env):
         """Arm shapes via robostrich_suite.rerun_log (geometry and the layout once, body poses per step)."""
-        from robostrich_suite import rerun_blueprint, rerun_log
         if not self._geometry_logged:
             self._geometry_logged = True
             self.file.send_blueprint(rerun_blueprint.rollout(side_view=not hasattr(env.physics, "from_trunk_frame")))
@@ -116,7 +115,6 @@ EVAL_FIELDS = ("success_rate", "position_error_median", "attitude_error_median",
 
 def log_training_curves(path: str, runs: Dict[str, List[dict]], evals: Dict[str, List[dict]] = None):
     """Training curves of each run on an `env_steps` timeline (one .rrd, one entity per run and field)."""
-    from robostrich_suite import rerun_blueprint, rerun_log
     groups = [(field.replace("_", " "), f"training/{field}") for field in CURVE_FIELDS]
     groups += [(f"held-out {field.replace('_', ' ')}", f"heldout/{field}") for field in EVAL_FIELDS]
     with rerun_log.recording("robostrich", path, recording_id="training",

@@ -41,6 +41,7 @@ import pathlib
 from typing import Callable
 
 from robostrich_suite.model import arm as arm_lib
+from robostrich_suite import targets
 
 MAX_TENDONS = 9  # the paper's 9 servos: the built-ins compare at the same actuation budget
 # A layout file may have more (robostrich-design's searches beyond the paper's family write them,
@@ -177,7 +178,6 @@ def target_file(name: str) -> pathlib.Path:
     format): pass ``targets.training_targets(target_file(name))`` as ``target_pool``."""
     check_built_in(name)
     if name == DEFAULT:
-        from robostrich_suite import targets
         return targets.DATA_PATH
     path = DATA_DIR / f"level_head_poses_{name}.npz"
     if not path.exists():
@@ -192,7 +192,6 @@ def task_kwargs(name: str) -> dict:
     """``task_kwargs`` for the reaching tasks on built-in layout ``name`` with its own
     shipped targets, e.g. ``robostrich_suite.load("robostrich", "lesson2",
     task_kwargs=layouts.task_kwargs("antagonist_pairs"))``."""
-    from robostrich_suite import targets
     return dict(tendon_layout=build(name), target_pool=targets.training_targets(target_file(name)))
 
 

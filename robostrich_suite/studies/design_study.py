@@ -16,6 +16,7 @@ import pathlib
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.model import layouts as layouts_lib
 from robostrich_suite.studies import design_objectives, design_space
+from robostrich_suite.studies import design_confirm
 
 RATIO_LIMIT = 0.6  # rolling / lever attitude ratio a routing must not pass (design.py's module doc)
 OBJECTIVES = ("coverage", "gap_column_m")  # both maximised
@@ -216,7 +217,6 @@ def confirm(study, count: int, out: pathlib.Path, show_progress: bool = True) ->
     the study once measured (a later run reports it without measuring it again)."""
     if not count or cli_lib.interrupted():
         return confirmed(study)
-    from robostrich_suite.studies import design_confirm
     done = {row["trial"]: row for row in confirmed(study)}
     todo = [t for t in pareto_front(study)[:count] if t.number not in done]
     slot_x = Settings.of(study).slot_x

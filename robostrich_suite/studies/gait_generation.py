@@ -7,7 +7,6 @@ The walking tasks replay the shipped file ``robostrich_suite/data/a1_trot.csv``
 """
 from __future__ import annotations
 
-import argparse
 import pathlib
 
 import numpy as np

@@ -37,6 +37,11 @@ import numpy as np
 from robostrich_suite import scenes
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
 from robostrich_suite.studies import gap_column
+from robostrich_suite import cli as cli_lib
+from robostrich_suite import physics as physics_lib
+from robostrich_suite.atomic_files import save_figure
+from robostrich_suite.atomic_files import write_text
+from robostrich_suite.studies import workspace
 
 MARGIN = 0.002  # m a sought pose keeps its capsules clear of the scene (checked at 0: gap_column.touching)
 ATTITUDE_AIM = LEVEL_TOLERANCE_DEG - 1.0  # deg: sought inside the tolerance, checked at it
@@ -65,8 +70,6 @@ class Arm:
 
     def __init__(self, spec=None):
         import mujoco
-        from robostrich_suite import physics as physics_lib
-        from robostrich_suite.studies import workspace
         physics = scenes.frame_physics(spec)
         self._mujoco, self.model, self.data = mujoco, physics.model.ptr, physics.data.ptr
         indices = physics_lib.arm_indices(physics.model)
@@ -286,7 +289,6 @@ def plot(rows: dict, result: dict, path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from robostrich_suite.atomic_files import save_figure
     need = gap_column.TASK_NEED
     fig, axes = plt.subplots(1, 3, figsize=(17, 5.6), gridspec_kw={"width_ratios": [1.2, 1, 1]})
     ax = axes[0]
@@ -338,8 +340,6 @@ def plot(rows: dict, result: dict, path) -> None:
 
 
 def main(argv=None) -> dict:
-    from robostrich_suite import cli as cli_lib
-    from robostrich_suite.atomic_files import write_text
     parser = argparse.ArgumentParser(prog="python -m robostrich_suite.studies.gap_bound",
                                      description=__doc__.splitlines()[0], allow_abbrev=False)
     parser.add_argument("--starts", type=cli_lib.whole_number(1, 10_000), default=STARTS,

@@ -41,6 +41,7 @@ import numpy as np
 from robostrich_suite import physics as physics_lib
 from robostrich_suite import scenes
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERANCE_DEG
+from robostrich_suite.studies import pose_seek, workspace
 
 COLUMN_TOLERANCE = 0.02  # m: a column's heads lie within this of the slot's centre in x
 MAX_STEP = 0.05  # m between neighbouring heads of a column: the tasks' position tolerance
@@ -284,7 +285,6 @@ def start_library(spec, slot_x=None):
     hold none 0.2-0.5 m ahead), the level poses with heads above the shelf over the range: the
     search still seeks there, and the way in (``design_objectives.passage_target``) has a target."""
     import mujoco
-    from robostrich_suite.studies import workspace
     key = (spec.joint_names, spec.link_lengths, spec.dorsal_limits_deg, spec.ventral_limits_deg, spec.head_length,
            None if slot_x is None else tuple(slot_x))
     if key not in _library:
@@ -310,7 +310,6 @@ def start_library(spec, slot_x=None):
 
 def hold_poses(physics, controls, to_plane, hold_time: float, interrupted=lambda: False) -> HeldPoses:
     """Hold each of ``controls`` from reset for ``hold_time`` s and record the pose."""
-    from robostrich_suite.studies import workspace
     geoms = arm_geoms(physics)
     n, m = len(controls), len(geoms) * SAMPLES_PER_CAPSULE
     held = HeldPoses(np.array(controls, float).reshape(n, physics.model.nu), np.zeros((n, 2)), np.zeros(n),
@@ -356,7 +355,6 @@ def measure(spec, layout, coarse_count: int, refine_count: int, seek_time: float
     poses sought at ``coarse_count`` spread heads of :func:`start_library` (each from its own
     kinematic pose's tendon lengths), then at ``refine_count`` more that would grow the tallest
     column found (:func:`refine_targets`; without one, at further library heads); the poses too."""
-    from robostrich_suite.studies import pose_seek, workspace
     physics = scenes.frame_physics(spec, layout)
     base = workspace.base_joint_xz(physics, spec)
 

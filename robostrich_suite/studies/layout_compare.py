@@ -45,6 +45,7 @@ from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite.model import layouts as layouts_lib
 from robostrich_suite.studies import coverage as coverage_lib
 from robostrich_suite.studies import movement, pose_seek, target_generation, workspace
+from robostrich_suite.studies import layout_figure
 
 PROG = "robostrich-layouts"
 DEFAULT_KINEMATIC_SAMPLES = 100_000  # the blue region: workspace.kinematic_samples(100000)
@@ -363,7 +364,6 @@ def report(args, cases, region, results, command: str) -> pathlib.Path:
     write_csv(args.out / "layouts.csv", rows)
     atomic_files.write_text(args.out / "layouts.json", json.dumps(
         {"benchmark": "layouts", "command": command, "blue_region": blue, "rows": rows}, indent=1) + "\n")
-    from robostrich_suite.studies import layout_figure
     figure = layout_figure.plot(cases, region, results, args.out / "layouts.png")
     print(table, end="")
     best = max(rows, key=lambda row: row["coverage"])
@@ -382,5 +382,4 @@ def cli(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    import sys
     sys.exit(cli())

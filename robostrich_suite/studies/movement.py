@@ -26,6 +26,8 @@ from robostrich_suite.model import arm as arm_lib
 from robostrich_suite import scenes
 from robostrich_suite.studies import movement_figure
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
+from robostrich_suite import rerun_blueprint
+from robostrich_suite import rerun_log
 
 PATTERNS = ("rolling", "lever")
 SETTLE_TIME = 3.0  # s before the ventral ramps start: the start pose comes to rest
@@ -214,7 +216,6 @@ def run(config: MovementConfig, spec: arm_lib.ArmSpec | None = None,
     sides = physics_lib.tendon_sides(model)
 
     if recording is not None:
-        from robostrich_suite import rerun_log
         rerun_log.log_geometry(recording, physics)
 
     physics.reset()
@@ -279,7 +280,6 @@ def match_lever_amplitude(config: MovementConfig, travel: float,
 
 def _log_frame(recording, physics, rows, names, sides) -> None:
     """One frame: body poses, tendon paths, inputs, attitude and the head path so far."""
-    from robostrich_suite import rerun_log
     t, control, contraction, head, attitude, _ = rows[-1]
     rerun_log.set_sim_time(recording, t)
     rerun_log.log_body_poses(recording, physics)
@@ -463,8 +463,6 @@ def run_patterns(args, base: MovementConfig, spec) -> tuple[dict, list]:
         if args.no_recording:
             movement = run(config, spec, progress=progress)
         else:
-            from robostrich_suite import rerun_log
-            from robostrich_suite import rerun_blueprint
             layout = rerun_blueprint.robot_and_series(MOVEMENT_SERIES, rerun_blueprint.SIDE_EYE)
             with rerun_log.recording(f"robostrich_movement_{pattern}", rrd, blueprint=layout) as recording:
                 movement = run(config, spec, recording=recording, progress=progress)

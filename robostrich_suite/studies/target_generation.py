@@ -15,7 +15,6 @@ names each file's command)::
 """
 from __future__ import annotations
 
-import argparse
 import pathlib
 
 import numpy as np
@@ -27,6 +26,9 @@ from robostrich_suite import progress as progress_lib
 from robostrich_suite import targets
 from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite.studies import pose_seek, workspace
+from robostrich_suite import scenes
+from robostrich_suite.model import layouts
+from robostrich_suite.studies import coverage
 
 SEEK_LEVEL_TIME = 2.5  # s of dorsal-input tuning per draw before it is held
 RECHECK_MIN_KEPT = 0.5  # a recheck that would drop more poses than this leaves the file alone
@@ -84,7 +86,6 @@ def seek_blue_region(kinematic_samples: int, seed: int = 0, workers: int = 2, sp
                      layout=None) -> workspace.ActuatedSamples:
     """One sought pose (held from the fixed start) per level head among ``kinematic_samples``
     kinematic samples, split over ``workers`` processes."""
-    from robostrich_suite.studies import coverage
     region = coverage.BlueRegion.from_samples(workspace.kinematic_samples(kinematic_samples, seed, spec))
     chunks = [(p, a, spec, layout) for p, a in zip(np.array_split(region.head_position, workers),
                                                   np.array_split(region.joint_angles, workers)) if len(p)]
@@ -101,7 +102,6 @@ def recheck(path: pathlib.Path, spec=None, layout=None, settle_time: float = pos
     ``layout``) and rewrite the file with the poses that still come to rest level, at
     the positions they reach now; returns ``(kept, stored)``.  Where fewer than half are
     kept the file is most likely another arm's: ValueError, and the file stays."""
-    from robostrich_suite import scenes
     poses = targets.level_head_poses(path)
     physics = scenes.frame_physics(spec, layout)
     if poses["control"].shape[1] != physics.model.nu:
@@ -169,7 +169,6 @@ def main(argv=None) -> None:
     outputs.check_file(args.out)
     layout = None
     if args.layout is not None:
-        from robostrich_suite.model import layouts
         layout = layouts.build(args.layout)
     if args.recheck:
         if not args.out.exists():

@@ -24,6 +24,7 @@ from robostrich_suite import physics as physics_lib
 from robostrich_suite import rerun_blueprint, rerun_log
 from robostrich_suite.robostrich_a1 import CONTROL_TIMESTEP, SUITE
 from robostrich_suite.tasks import gait as gait_lib
+from robostrich_suite.studies import walk_figure
 
 
 # What walk.rrd opens on: the robot beside the series a reader of Fig. 9 compares (plots/ holds more).
@@ -127,7 +128,6 @@ def _walk_steps(env, script, steps: int, rec, bar) -> dict:
 
 
 def _at_least_one_step(text: str) -> float:
-    import argparse
     try:
         seconds = float(text)
     except ValueError:
@@ -152,7 +152,6 @@ def out_directory_problem(out: pathlib.Path) -> str | None:
 
 def main(argv=None) -> None:
     """The walk tool: trot with scripted tendons, write a Rerun recording and a PNG."""
-    from robostrich_suite.studies import walk_figure
     parser = cli_lib.Parser(
         description="Walk the quadruped with the arm on it; write walk.rrd and walk.png under --out "
                     "(trunk and head height, speed and attitude over time).")

@@ -14,7 +14,6 @@ one source of the tasks' targets (see :mod:`robostrich_suite.targets`).
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import pathlib
 import time
@@ -333,7 +332,6 @@ def main(argv=None) -> dict:
 
 def cli(argv=None) -> int:
     """Console script `robostrich-workspace`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
-    from robostrich_suite import cli as cli_lib
     return cli_lib.run(main, "robostrich-workspace", argv)
 
 

@@ -43,6 +43,7 @@ from robostrich_suite.model import quadruped as quad
 from robostrich_suite import scenes
 from robostrich_suite.tasks import gait as gait_lib
 from robostrich_suite.tasks import options, perturbations, reach, target_samplers, track
+from robostrich_suite import targets
 
 SETTLE_TIME = 0.2  # s of standing physics before each fresh episode
 LESSON4_TIME_LIMIT = 6.0  # s: stand-in, lowered/raised, back (one height change)
@@ -87,7 +88,6 @@ GAP_TARGETS = np.array([
 
 def default_target_pool() -> np.ndarray:
     """``robostrich``'s level-head training targets, in the trunk frame (module doc)."""
-    from robostrich_suite import targets
     return frame_to_trunk(targets.training_targets())
 
 

@@ -34,6 +34,7 @@ from robostrich_suite.tasks.target_samplers import MAX_TARGET_DISTANCE, TargetSa
 from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG as DESIRED_ATTITUDE
 from robostrich_suite.tasks.conventions import LEVEL_TOLERANCE_DEG as ATTITUDE_TOLERANCE
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, POSITION_TOLERANCE
+from robostrich_suite import targets
 
 REWARDS = ("lesson1", "lesson2")
 
@@ -123,7 +124,6 @@ class Reach(base.Task):
                                         config.release_starts, config.release_time)
         pool = config.target_pool
         if pool is None:
-            from robostrich_suite import targets
             pool = targets.training_targets()
         self.sampler = TargetSampler(pool, config.target_sampling)
         self._set_reward(config)

@@ -8,6 +8,7 @@ from robostrich_suite.tasks import options
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
 from robostrich_suite.tasks.reach import Reach, length
 from robostrich_suite.tasks.target_samplers import as_targets
+from robostrich_suite import targets as targets_lib
 
 MAX_STEPS_PER_TARGET = int(options.MAX_SECONDS / CONTROL_TIMESTEP)  # a target held for the longest episode
 
@@ -16,7 +17,6 @@ class Track(Reach):
 
     def __init__(self, targets=None, steps_per_target: int = 250, **kwargs):
         if targets is None:
-            from robostrich_suite import targets as targets_lib
             targets = default_track_targets(targets_lib.heldout_targets())
         targets = as_targets(targets, "targets")
         steps_per_target = options.whole("steps_per_target", steps_per_target, 1, MAX_STEPS_PER_TARGET,
