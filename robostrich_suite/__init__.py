@@ -58,6 +58,7 @@ except (ImportError, AttributeError, OSError) as _error:
 
 from robostrich_suite.policies import load_policy  # noqa: E402,F401  (a shipped trained policy)
 from robostrich_suite.model import layouts
+from robostrich_suite.tasks import lessons
 
 _DOMAINS = collections.OrderedDict([("robostrich", robostrich), ("robostrich_a1", robostrich_a1)])
 
@@ -66,7 +67,29 @@ ALL_TASKS = tuple((domain, task) for domain, module in _DOMAINS.items()
 TASKS_BY_DOMAIN = collections.OrderedDict(
     (domain, tuple(module.SUITE)) for domain, module in _DOMAINS.items())
 CURRICULUM_TASKS = tuple((domain, task) for domain, module in _DOMAINS.items()
-                         for task in module.SUITE.tagged("curriculum"))
+                         for task in module.SUITE.tagged(lessons.CURRICULUM))
+def mount(domain_name: str) -> str:
+    """What ``domain_name``'s arm stands on: ``"frame"`` (immobile) or ``"quadruped"`` (walking)."""
+    return _domain_module(domain_name).MOUNT
+
+
+def tasks_tagged(domain_name: str, tag: str) -> tuple:
+    """The tasks of ``domain_name`` with ``tag`` (robostrich_suite/tasks/lessons.py names the tags:
+    ``heldout``, ``moving_start``, ``track``, ``draws_targets``, ``curriculum``, ``evaluation``),
+    in registry order; an unknown domain is a ValueError naming the known ones."""
+    return tuple(_domain_module(domain_name).SUITE.tagged(tag))
+
+
+def targets_from_frame(domain_name: str, frame_targets):
+    """(x, z) targets of the arm on its frame in ``domain_name``'s coordinates (the trunk frame on
+    the quadruped), as its tasks take them."""
+    return _domain_module(domain_name).targets_from_frame(frame_targets)
+
+
+def _domain_module(domain_name: str):
+    if domain_name not in _DOMAINS:
+        raise ValueError(f"unknown domain {domain_name!r}; use one of {list(_DOMAINS)}")
+    return _DOMAINS[domain_name]
 
 
 def _register_gymnasium_environments() -> list[str]:

@@ -29,6 +29,7 @@ TRACK_STEPS_PER_TARGET = 250
 XML_PRECISION = 10  # significant digits in the generated MJCF (readable, and exact enough)
 
 SUITE = containers.TaggedTasks()
+MOUNT = "frame"  # the arm stands on an immobile frame
 
 
 def get_model_and_assets(arm_spec=None, tendon_layout=None):
@@ -46,7 +47,12 @@ _FACTORY = lessons.LessonFactory(Physics, get_model_and_assets, reach.Reach)
 _FACTORY.add_lessons(SUITE, ".")
 
 
-@SUITE.add("evaluation")
+def targets_from_frame(frame_targets):
+    """Targets of the arm on its frame in this domain's coordinates: the same ones."""
+    return frame_targets
+
+
+@SUITE.add(lessons.EVALUATION, lessons.TRACK)
 def track(time_limit=None, random=None, environment_kwargs=None, arm_spec=None,
           tendon_layout=None, targets=None, steps_per_target=TRACK_STEPS_PER_TARGET,
           **task_kwargs):

@@ -37,6 +37,7 @@ from robostrich_suite.tasks import quadruped_tasks as tasks
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
 
 SUITE = containers.TaggedTasks()
+MOUNT = "quadruped"  # the arm rides the walking quadruped
 
 
 @functools.lru_cache(maxsize=4)
@@ -60,7 +61,11 @@ _FACTORY = lessons.LessonFactory(Physics, get_model_and_assets, tasks.QuadrupedR
 _FACTORY.add_lessons(SUITE, ", with the quadruped standing.")
 
 
-@SUITE.add("curriculum")
+# Targets of the arm on its frame in this domain's coordinates: its trunk frame, standing.
+targets_from_frame = tasks.frame_to_trunk
+
+
+@SUITE.add(lessons.CURRICULUM, lessons.DRAWS_TARGETS)
 def lesson4(time_limit=tasks.LESSON4_TIME_LIMIT, random=None, environment_kwargs=None,
             arm_spec=None, tendon_layout=None, height_range=tasks.LESSON4_HEIGHT_RANGE,
             **task_kwargs):
@@ -73,7 +78,7 @@ def lesson4(time_limit=tasks.LESSON4_TIME_LIMIT, random=None, environment_kwargs
                            tendon_layout, task_kwargs, legs="walk", trunk_heights=heights)
 
 
-@SUITE.add("evaluation")
+@SUITE.add(lessons.EVALUATION)
 def head_stabilize(time_limit=tasks.HEAD_STABILIZE_TIME_LIMIT, random=None,
                    environment_kwargs=None, arm_spec=None, tendon_layout=None,
                    distance=tasks.HEAD_STABILIZE_DISTANCE, height=tasks.HEAD_STABILIZE_HEIGHT,
@@ -89,7 +94,7 @@ def head_stabilize(time_limit=tasks.HEAD_STABILIZE_TIME_LIMIT, random=None,
     return _FACTORY.environment(task, time_limit, arm_spec, tendon_layout, environment_kwargs)
 
 
-@SUITE.add("evaluation")
+@SUITE.add(lessons.EVALUATION)
 def narrow_gap(time_limit=None, random=None, environment_kwargs=None, arm_spec=None,
                tendon_layout=None, steps_per_target=tasks.NARROW_GAP_STEPS_PER_TARGET,
                **task_kwargs):

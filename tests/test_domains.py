@@ -199,3 +199,20 @@ def test_stored_starts_come_from_the_lookup_table_without_the_evaluations_moving
     # The same poses on the standing quadruped (the arm holds them as on the frame).
     a1 = Domain("robostrich_a1", LAYOUT)
     np.testing.assert_array_equal(a1.make_environment("lesson3", 0, stored_starts=0.5).task.start_inputs, inputs)
+
+
+def test_the_registry_names_each_domains_evaluation_tasks_and_mount():
+    """The agent layer reads these facts from the suite's registry (tags), not from task names."""
+    import robostrich_suite
+    for name, mount in (("robostrich", "frame"), ("robostrich_a1", "quadruped")):
+        domain = Domain(name)
+        assert robostrich_suite.mount(name) == mount and domain.on_quadruped == (mount == "quadruped")
+        assert domain.heldout_task("ignored") == "lesson2" and domain.moving_start_task == "lesson3"
+        assert set(robostrich_suite.tasks_tagged(name, "draws_targets")) == set(domain.curriculum())
+    assert robostrich_suite.tasks_tagged("robostrich", "track") == ("track",)
+    assert robostrich_suite.tasks_tagged("robostrich_a1", "track") == ()
+    frame = np.array([[0.1, 0.3]])
+    np.testing.assert_array_equal(robostrich_suite.targets_from_frame("robostrich", frame), frame)
+    assert not np.allclose(robostrich_suite.targets_from_frame("robostrich_a1", frame), frame)
+    with pytest.raises(ValueError, match="unknown domain 'cartpole'"):
+        robostrich_suite.tasks_tagged("cartpole", "heldout")

@@ -86,7 +86,7 @@ def test_one_hold_per_moving_start_scores_every_target_as_a_hold_before_each_tar
     from robostrich_suite.tasks.measurement import measure
     policy, chosen = policies.load_policy("robostrich"), targets.heldout_targets()[:2]
     report = evaluation.evaluate_heldout_moving(policy, flattener, "robostrich", targets=chosen)
-    env = make_environment("robostrich", evaluation.MOVING_START_TASK, 30_000, target_pool=chosen[:1])
+    env = make_environment("robostrich", "lesson3", 30_000, target_pool=chosen[:1])
     expected = []
     for start, control in zip(*evaluation.moving_starts()):
         for target in chosen:  # as the evaluation ran before: hold the start before every target

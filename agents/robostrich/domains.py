@@ -25,14 +25,10 @@ from agents.robostrich.lookup import lookup_table, nearest
 from robostrich_suite import targets
 from robostrich_suite.model import layouts
 from robostrich_suite.studies import new_targets
-from robostrich_suite.tasks import options, quadruped_tasks, reach
+from robostrich_suite.tasks import lessons, options, reach
 from robostrich_suite.tasks.track import default_track_targets
 
-# Tasks on an arm domain whose episodes start from the fixed pose (held-out
-# evaluation) and continue from the last state (moving starts).
-HELDOUT_TASK = "lesson2"
-MOVING_START_TASK = "lesson3"
-TRACK_TASK = "track"
+TRACK_TASK = "track"  # the name --track-task asks for by default (the frame arm's task tagged "track")
 
 
 def arm_domains() -> Tuple[str, ...]:
@@ -94,7 +90,11 @@ class Domain:
 
     @property
     def on_quadruped(self) -> bool:
-        return self.name == "robostrich_a1"
+        return self.is_arm and robostrich_suite.mount(self.name) == "quadruped"
+
+    def tagged(self, tag: str) -> Tuple[str, ...]:
+        """This arm domain's tasks with ``tag`` (robostrich_suite.tasks_tagged); none off the arm."""
+        return robostrich_suite.tasks_tagged(self.name, tag) if self.is_arm else ()
 
     # -- environments ------------------------------------------------------------------------
     def target_file(self):
@@ -103,19 +103,17 @@ class Domain:
 
     def _to_domain_frame(self, frame_targets) -> np.ndarray:
         """Targets of the frame arm in this domain's coordinates (the trunk frame on the quadruped)."""
-        frame_targets = np.asarray(frame_targets, np.float64)
-        if self.on_quadruped:
-            return quadruped_tasks.frame_to_trunk(frame_targets)
-        return frame_targets
+        return np.asarray(robostrich_suite.targets_from_frame(self.name, np.asarray(frame_targets, np.float64)),
+                          np.float64)
 
     def layout_kwargs(self, task: str) -> dict:
         """The task kwargs a layout implies: the layout, and its own training (or `track`) targets."""
         if self.layout is None:
             return {}
         kwargs = {"tendon_layout": layouts.build(self.layout)}
-        if task == TRACK_TASK:
+        if task in self.tagged(lessons.TRACK):
             kwargs["targets"] = default_track_targets(self.heldout_targets())
-        elif task.startswith("lesson"):  # head_stabilize and narrow_gap have their own targets
+        elif task in self.tagged(lessons.DRAWS_TARGETS):  # head_stabilize and narrow_gap have their own targets
             kwargs["target_pool"] = self._to_domain_frame(targets.training_targets(self.target_file()))
         return kwargs
 
@@ -135,7 +133,7 @@ class Domain:
     # -- evaluation --------------------------------------------------------------------------
     def heldout_task(self, final_task: str) -> str:
         """lesson2 on the arm (eq. 10 from the fixed pose, so every target starts alike); else the final task."""
-        return HELDOUT_TASK if self.is_arm else final_task
+        return self.tagged(lessons.HELDOUT)[0] if self.is_arm else final_task
 
     def track_task(self, requested: Optional[str] = TRACK_TASK) -> Optional[str]:
         """`requested` where this domain has it (the frame arm's `track`), else None."""
@@ -143,7 +141,12 @@ class Domain:
 
     @property
     def has_moving_starts(self) -> bool:
-        return self.is_arm and MOVING_START_TASK in self.tasks()
+        return bool(self.tagged(lessons.MOVING_START))
+
+    @property
+    def moving_start_task(self) -> str:
+        """The task whose episodes continue from where the last ended (moving starts)."""
+        return self.tagged(lessons.MOVING_START)[0]
 
     def heldout_targets(self, num_targets: Optional[int] = None) -> Optional[np.ndarray]:
         """The layout's held-out targets in this domain's frame; None (seeded episodes) off the arm."""

@@ -24,6 +24,17 @@ from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP
 
 LESSON_TIME_LIMIT = 2.0  # s (250 control steps): the tendon servos bring the neck to rest in ~1.5 s
 
+# What a task is for, as tags of the domains' registries (``robostrich_suite.tasks_tagged``), so
+# that code judging a policy asks the registry instead of knowing task names.
+CURRICULUM = "curriculum"  # a lesson of Algorithm 1, in order
+DRAWS_TARGETS = "draws_targets"  # each episode's target drawn from a pool (``target_pool``)
+HELDOUT = "heldout"  # held-out targets are judged here: eq. 10 from the fixed start, every target alike
+MOVING_START = "moving_start"  # each episode continues from where the last ended
+TRACK = "track"  # several targets in turn (Fig. 7)
+EVALUATION = "evaluation"  # an evaluation of its own, not a lesson
+# the tags of each lesson beside CURRICULUM and DRAWS_TARGETS
+LESSON_TAGS = {"lesson1": (), "lesson2": (HELDOUT,), "lesson3": (MOVING_START,)}
+
 # name -> (reward, initial state, what the lesson asks)
 LESSONS = {
     "lesson1": ("lesson1", "fixed", "Lesson 1: position only (eq. 9), from the fixed initial pose"),
@@ -76,11 +87,11 @@ class LessonFactory:
         return self.environment(task, time_limit, arm_spec, tendon_layout, environment_kwargs)
 
     def add_lessons(self, suite, setting: str) -> None:
-        """Register ``lesson1``-``lesson3`` in ``suite`` (tagged ``curriculum``); ``setting``
+        """Register ``lesson1``-``lesson3`` in ``suite`` (tagged ``LESSON_TAGS``); ``setting``
         ends each lesson's docstring (", with the quadruped standing.")."""
         for name, (reward, initial_state, summary) in LESSONS.items():
-            suite.add("curriculum")(self._lesson_factory(name, reward, initial_state,
-                                                          summary + setting))
+            suite.add(CURRICULUM, DRAWS_TARGETS, *LESSON_TAGS[name])(
+                self._lesson_factory(name, reward, initial_state, summary + setting))
 
     def _lesson_factory(self, name, reward, initial_state, doc):
         def lesson(time_limit=LESSON_TIME_LIMIT, random=None, environment_kwargs=None,

@@ -18,7 +18,7 @@ import numpy as np
 from agents import checkpoint
 from agents.curriculum import LessonSettings
 from agents.replay import ObservationFlattener
-from agents.robostrich.domains import as_domain, domain_of, MOVING_START_TASK, TRACK_TASK
+from agents.robostrich.domains import as_domain, domain_of, TRACK_TASK
 from agents.robostrich.lookup import LABEL, LookupPolicy
 from agents.robostrich.evaluate import lookup_cache
 from agents.robostrich.recording import open_recorder
@@ -206,7 +206,8 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
     """
     targets = heldout_targets(domain, num_targets) if targets is None else np.asarray(targets, np.float64)
     start_positions, start_controls = moving_starts(domain=domain) if starts is None else starts
-    env = make_environment(domain, MOVING_START_TASK, seed, target_pool=targets[:1])
+    task = as_domain(domain).moving_start_task
+    env = make_environment(domain, task, seed, target_pool=targets[:1])
     episodes = []
     for k, (start, control) in enumerate(zip(start_positions, start_controls)):
         rest, held = _rest_at(env, start, control)
@@ -222,7 +223,7 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
             episodes.append(row)
             if on_episode:
                 on_episode()
-    return {"kind": kind, **_names(domain), "task": MOVING_START_TASK, "summary": summarize(episodes),
+    return {"kind": kind, **_names(domain), "task": task, "summary": summarize(episodes),
             "episodes": episodes}
 
 
