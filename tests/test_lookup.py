@@ -9,6 +9,7 @@ from dm_env import specs
 
 from agents.robostrich.evaluate import evaluation
 from agents.robostrich.domain_run import DomainRun, make_environment, parse_plan
+from agents.robostrich.domains import Domain
 from agents.robostrich.lookup import LookupPolicy, lookup_table
 from agents.replay import ObservationFlattener
 from agents.sac.builder import SACBuilder
@@ -68,7 +69,7 @@ def test_heldout_moving_starts_from_poses_holding_other_targets(flattener):
     policy = LookupPolicy(flattener)
     target = targets.heldout_targets()[:1]
     report = evaluation.evaluate_heldout_moving(policy, flattener, "robostrich", targets=target)
-    starts, _ = evaluation.moving_starts()
+    starts, _ = Domain("robostrich").moving_starts()
     assert report["summary"]["episodes"] == 3 and [e["start"] for e in report["episodes"]] == [0, 1, 2]
     assert distances(starts, targets.training_targets()).min(axis=1).max() == 0.0  # starts are training targets
     assert distances(starts, starts)[np.triu_indices(3, 1)].min() > 0.15  # well separated (0.16 m apart at least)
@@ -88,7 +89,7 @@ def test_one_hold_per_moving_start_scores_every_target_as_a_hold_before_each_tar
     report = evaluation.evaluate_heldout_moving(policy, flattener, "robostrich", targets=chosen)
     env = make_environment("robostrich", "lesson3", 30_000, target_pool=chosen[:1])
     expected = []
-    for start, control in zip(*evaluation.moving_starts()):
+    for start, control in zip(*Domain("robostrich").moving_starts()):
         for target in chosen:  # as the evaluation ran before: hold the start before every target
             env.task.set_initial_state("fixed")
             env.task.set_target_pool(start)

@@ -152,8 +152,7 @@ class Domain:
         """The layout's held-out targets in this domain's frame; None (seeded episodes) off the arm."""
         if not self.is_arm:
             return None
-        pool = self._to_domain_frame(targets.heldout_targets(self.target_file()))
-        return pool if num_targets is None else pool[spread_indices(len(pool), num_targets)]
+        return self._to_domain_frame(targets.heldout_targets(self.target_file(), num_targets))
 
     def new_targets(self, count: int, seed: Optional[int] = None) -> Optional[np.ndarray]:
         """``count`` level poses of this layout at least 1 cm from every pose of its target file,
@@ -198,17 +197,6 @@ class Domain:
         """What a policy file or report keeps to rebuild this domain (:func:`domain_of`)."""
         return {"domain": self.name, **({"layout": self.layout} if self.layout else {}),
                 **({"observe_sent_actions": self.sent_actions} if self.sent_actions else {})}
-
-
-def spread_indices(count: int, wanted: int) -> np.ndarray:
-    """`wanted` indices spread evenly over range(count) (all of them if wanted >= count).
-
-    Why: the held-out targets are stored in generation order, which runs through the workspace
-    region by region; the first 20 of 44 on `antagonist_pairs` miss its upper targets, where a
-    policy can fail while the periodic evaluation reads 95 %."""
-    if wanted >= count:
-        return np.arange(count)
-    return np.unique(np.round(np.linspace(0, count - 1, max(int(wanted), 1))).astype(int))
 
 
 def domain_of(info: dict, task_kwargs: Optional[dict] = None) -> Domain:

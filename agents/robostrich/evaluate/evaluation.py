@@ -150,47 +150,35 @@ def check_track_task(domain, requested: Optional[str]) -> Optional[str]:
     return domain.track_task(requested)
 
 
-def heldout_targets(domain, num_targets: Optional[int] = None):
-    """The arm domain's (and layout's) held-out targets; None (seeded episodes) elsewhere."""
-    return as_domain(domain).heldout_targets(num_targets)
-
-
-def _names(domain) -> dict:
-    return as_domain(domain).info()
-
-
 def evaluate_heldout(actor, flattener, domain, task: str, num_targets: Optional[int] = None,
                      seed: int = 10_000, targets=None, action_repeat: int = 1, on_episode=None,
                      kind: str = "heldout") -> dict:
     """Deterministic policy, one episode per held-out target (a pool of that single target).
 
     Use a task with a fixed initial state (lesson2): every target then starts from the same pose.
+    The domain's held-out targets (None off the arm: seeded episodes) unless ``targets`` are given.
     """
+    domain = as_domain(domain)
+    report = {"kind": kind, **domain.info(), "task": task}
     if targets is None:
-        targets = heldout_targets(domain, num_targets)
+        targets = domain.heldout_targets(num_targets)
     episodes = []
     count = len(targets) if targets is not None else (num_targets or 10)
     env = None
     for i in range(count):
         if targets is None:
-            env = make_environment(domain, task, seed + i)
+            env = domain.make_environment(task, seed + i)
         elif env is not None:
             env.task.set_target_pool(targets[i])  # reuse the compiled model (building one takes ~0.3 s)
         else:
-            env = make_environment(domain, task, seed, target_pool=targets[i:i + 1])
+            env = domain.make_environment(task, seed, target_pool=targets[i:i + 1])
         row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat))
         if targets is not None:
             row["target"] = targets[i].tolist()
         episodes.append(row)
         if on_episode:
             on_episode()
-    return {"kind": kind, **_names(domain), "task": task, "summary": summarize(episodes), "episodes": episodes}
-
-
-def moving_starts(count: int = 3, domain="robostrich"):
-    """Start poses of `heldout_moving`: `count` well separated training targets (picked as `track` picks its
-    targets) and the stored inputs that hold them (from the lookup table, so never a held-out pose)."""
-    return as_domain(domain).moving_starts(count)
+    return {**report, "summary": summarize(episodes), "episodes": episodes}
 
 
 def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: Optional[int] = None,
@@ -204,10 +192,12 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
     episode from that resting state. `starts` = (positions, controls). With
     ``one_start_each`` target i is tried from start i mod the number of starts only.
     """
-    targets = heldout_targets(domain, num_targets) if targets is None else np.asarray(targets, np.float64)
-    start_positions, start_controls = moving_starts(domain=domain) if starts is None else starts
-    task = as_domain(domain).moving_start_task
-    env = make_environment(domain, task, seed, target_pool=targets[:1])
+    domain = as_domain(domain)
+    task = domain.moving_start_task
+    report = {"kind": kind, **domain.info(), "task": task}
+    targets = domain.heldout_targets(num_targets) if targets is None else np.asarray(targets, np.float64)
+    start_positions, start_controls = domain.moving_starts() if starts is None else starts
+    env = domain.make_environment(task, seed, target_pool=targets[:1])
     episodes = []
     for k, (start, control) in enumerate(zip(start_positions, start_controls)):
         rest, held = _rest_at(env, start, control)
@@ -223,8 +213,7 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
             episodes.append(row)
             if on_episode:
                 on_episode()
-    return {"kind": kind, **_names(domain), "task": task, "summary": summarize(episodes),
-            "episodes": episodes}
+    return {**report, "summary": summarize(episodes), "episodes": episodes}
 
 
 def _rest_at(env, start, control):
@@ -242,7 +231,9 @@ def _rest_at(env, start, control):
 def evaluate_track(actor, flattener, domain="robostrich", task: str = "track", seed: int = 20_000,
                    recorder=None, action_repeat: int = 1) -> dict:
     """The `track` task: targets in order (Fig. 7); one summary per target segment plus the series."""
-    env = make_environment(domain, task, seed)
+    domain = as_domain(domain)
+    report = {"kind": "track", **domain.info(), "task": task}
+    env = domain.make_environment(task, seed)
     series = rollout(env, actor, flattener, recorder.log_step if recorder is not None else None,
                      action_repeat=action_repeat)
     segments = []
@@ -252,8 +243,7 @@ def evaluate_track(actor, flattener, domain="robostrich", task: str = "track", s
         row = _episode_summary(series, start, end)
         row.update(start_step=start, target=targets[start] if targets else None)
         segments.append(row)
-    return {"kind": "track", **_names(domain), "task": task, "segments": segments,
-            "summary": summarize(segments), "series": series}
+    return {**report, "segments": segments, "summary": summarize(segments), "series": series}
 
 
 def evaluate_agent(actor, flattener, out_dir: str, label: str, domain, heldout_task: str,
@@ -294,10 +284,10 @@ def episode_count(domain, num_targets: Optional[int], track_task: Optional[str],
     start and, on the arm, from each moving start; each of ``new_targets`` new targets from the
     fixed start and from one moving start; one `track` episode."""
     domain = as_domain(domain)
-    targets = heldout_targets(domain, num_targets)
+    targets = domain.heldout_targets(num_targets)
     count = len(targets) if targets is not None else (num_targets or 10)
     moving = domain.has_moving_starts
-    return (count * (1 + (len(moving_starts(domain=domain)[0]) if moving else 0)) + new_targets * (1 + moving)
+    return (count * (1 + (len(domain.moving_starts()[0]) if moving else 0)) + new_targets * (1 + moving)
             + bool(track_task))
 
 
