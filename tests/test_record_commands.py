@@ -34,7 +34,8 @@ def _resolved(train_argv: list):
 
 
 def test_the_records_name_the_main_job_and_the_peers():
-    assert {"main_job", "main_job_600k", "main_job_plain_inputs", "quadruped_main_job"} <= set(SEED_RECORDS)
+    assert {"main_job", "main_job_list_targets", "main_job_600k", "main_job_plain_inputs",
+            "quadruped_main_job"} <= set(SEED_RECORDS)
     assert {"peers", "peers_100k"} <= set(PEER_RECORDS)
 
 
@@ -64,7 +65,7 @@ def test_the_earlier_main_jobs_resolve_to_their_own_settings_not_todays():
         assert config != today
 
 
-LIST_TARGET_RECORDS = ("antagonist_pairs", "main_job", "main_job_600k", "main_job_plain_inputs")  # before 2026-12-07
+LIST_TARGET_RECORDS = ("antagonist_pairs", "main_job_list_targets", "main_job_600k", "main_job_plain_inputs")  # before 2026-12-07
 
 
 def test_records_made_before_targets_between_the_stored_poses_train_on_the_list(tmp_path):
@@ -72,6 +73,9 @@ def test_records_made_before_targets_between_the_stored_poses_train_on_the_list(
     before keep their list of targets by their commands' flag, for ours and the peers alike."""
     from agents.robostrich.domains import Domain
     assert main_job.resolve_task_kwargs({}, Domain("robostrich"))["target_between"] == 4
+    _, passthrough = sweep.build_parser().parse_known_args(_arguments("main_job"))  # today's main job
+    args = training.build_parser().parse_args(passthrough)
+    assert main_job.resolve_task_kwargs(args.task_kwargs, Domain("robostrich"))["target_between"] == 4
     assert "target_between" not in main_job.resolve_task_kwargs({}, Domain("robostrich_a1"))
     for name in LIST_TARGET_RECORDS:
         _, passthrough = sweep.build_parser().parse_known_args(_arguments(name))
