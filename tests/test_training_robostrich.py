@@ -83,7 +83,8 @@ def test_main_job_writes_reports_figures_recordings_and_evaluate_reproduces_them
     # the main job's defaults on the arm: the layout it learns and the precision term (docs/training.md#the-main-job)
     assert recorded["layout"] == "ventral_slips"  # the tasks' own routing, by name
     assert recorded["task_kwargs"] == {"weights": {"position_precision": 1.0, "attitude_precision": 0.5},
-                                       "target_sampling": "failures", "fixed_stored_starts": 0.25}
+                                       "target_sampling": "failures", "fixed_stored_starts": 0.25,
+                                       "target_between": 4}
     assert recorded["lessons"]["her_lessons"] == ["lesson1"]
     assert recorded["config"]["her_ratio"] == 0.5 and "her_level_goals" not in recorded["config"]
     reports = evaluate_command.main([os.path.join(out, "curriculum", "checkpoint.ckpt"), "--out", str(tmp_path / "ev"),

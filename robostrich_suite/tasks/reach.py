@@ -144,7 +144,6 @@ class Reach(base.Task):
                                             f"a distance from 0 to {MAX_TARGET_JITTER:g} m")
         self.target_between = options.whole("target_between", config.target_between, 0, MAX_TARGET_BETWEEN,
                                             "a whole number of nearest neighbours")
-        self._neighbours = (None, None)  # (pool, its nearest neighbours' indices), see _pool_neighbours
         self._sent_actions = None  # (observe_sent_actions, tendons), newest first, see before_step
         self._robot_ready = False  # see _begin_robot
         self.target_position = self.target_pool[0].copy()
@@ -269,27 +268,7 @@ class Reach(base.Task):
 
     def next_target(self) -> np.ndarray:
         target = self.sampler.draw(self.random, self.initial_state)
-        if self.target_between and len(self.sampler.pool) > 1:
-            neighbours = self._pool_neighbours()
-            other = self.sampler.pool[neighbours[self.sampler.index, self.random.randint(neighbours.shape[1])]]
-            target = target + self.random.uniform() * (other - target)
-        if self.target_jitter:  # uniform over the disk: the radius as the square root of a uniform draw
-            radius = self.target_jitter * np.sqrt(self.random.uniform())
-            angle = self.random.uniform(0.0, 2.0 * np.pi)
-            target = target + radius * np.array([np.cos(angle), np.sin(angle)])
-        return target
-
-    def _pool_neighbours(self) -> np.ndarray:
-        """(pool size, k) indices of each pool pose's nearest other poses, made once per pool."""
-        pool, neighbours = self._neighbours
-        if pool is not self.sampler.pool:
-            pool = self.sampler.pool
-            distances = np.linalg.norm(pool[:, None] - pool[None], axis=2)
-            np.fill_diagonal(distances, np.inf)
-            k = min(self.target_between, len(pool) - 1)
-            neighbours = np.argsort(distances, axis=1)[:, :k]
-            self._neighbours = (pool, neighbours)
-        return neighbours
+        return self.sampler.moved(target, self.random, self.target_between, self.target_jitter)
 
     # --- checkpoints ----------------------------------------------------------
     def checkpoint_state(self) -> dict:

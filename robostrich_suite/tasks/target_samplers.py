@@ -49,6 +49,7 @@ class TargetSampler:
         self.tries = np.zeros(len(self.pool), np.int64)
         self.failures = np.zeros(len(self.pool), np.int64)
         self.index = None
+        self._neighbours = None  # each pose's nearest others, see moved
 
     def by_failures(self, initial_state: str) -> bool:
         """Whether a lesson with this initial state draws by failure rate (and scores its episodes)."""
@@ -83,3 +84,20 @@ class TargetSampler:
         else:
             self.index = int(random.randint(len(self.pool)))
         return self.pool[self.index].copy()
+
+    def moved(self, target, random, between: int = 0, jitter: float = 0.0) -> np.ndarray:
+        """The last drawn ``target`` moved a uniform share of the way towards one of its ``between``
+        nearest pool poses, then uniformly within a disk of radius ``jitter`` (m): training that
+        meets the poses between the pool's (the reaching task's ``target_between`` and ``target_jitter``)."""
+        if between and len(self.pool) > 1:
+            if self._neighbours is None or self._neighbours.shape[1] != min(between, len(self.pool) - 1):
+                distances = np.linalg.norm(self.pool[:, None] - self.pool[None], axis=2)
+                np.fill_diagonal(distances, np.inf)
+                self._neighbours = np.argsort(distances, axis=1)[:, :min(between, len(self.pool) - 1)]
+            other = self.pool[self._neighbours[self.index, random.randint(self._neighbours.shape[1])]]
+            target = target + random.uniform() * (other - target)
+        if jitter:  # uniform over the disk: the radius as the square root of a uniform draw
+            radius = jitter * np.sqrt(random.uniform())
+            angle = random.uniform(0.0, 2.0 * np.pi)
+            target = target + radius * np.array([np.cos(angle), np.sin(angle)])
+        return target

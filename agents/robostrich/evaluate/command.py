@@ -63,6 +63,14 @@ def new_targets_of(domain, args, heldout_count: Optional[int]) -> Optional[np.nd
     return domain.new_targets(count, args.new_target_seed)
 
 
+def start_line(args, domain, track_task: Optional[str]) -> str:
+    """What the evaluation is about to do, in words: the checkpoint, its domain and what it is judged on."""
+    kinds = ["held-out targets"] + (["new targets"] if domain.is_arm and args.new_targets != 0 else []) \
+        + ([f"the {track_task} task"] if track_task else [])
+    return (f"evaluating {args.checkpoint} on {domain.name}" + (f" ({domain.layout})" if domain.layout else "")
+            + f": {', '.join(kinds)}" + (", and the lookup baseline on the same" if domain.is_arm else ""))
+
+
 def main(argv=None):
     parser = cli_lib.Parser(description="Evaluate a checkpoint (and, on the arm, the lookup baseline): "
                                                  "held-out targets and the track task.")
@@ -93,11 +101,7 @@ def main(argv=None):
     heldout_task = check_heldout_task(domain, args.heldout_task
                                       or default_heldout_task(domain, parse_plan(fingerprint["plan"])[-1].task))
     if not args.quiet:  # before the seconds of making new targets and rebuilding the run
-        kinds = ["held-out targets"] + (["new targets"] if domain.is_arm and args.new_targets != 0 else []) \
-            + ([f"the {track_task} task"] if track_task else [])
-        print(f"evaluating {args.checkpoint} on {domain.name}" + (f" ({domain.layout})" if domain.layout else "")
-              + f": {', '.join(kinds)}" + (", and the lookup baseline on the same" if domain.is_arm else ""),
-              file=sys.stderr, flush=True)
+        print(start_line(args, domain, track_task), file=sys.stderr, flush=True)
     new = new_targets_of(domain, args, args.num_targets)
     run = load_run_from_checkpoint(args.checkpoint)
     actor = SACBuilder.make_eval_actor(run.loop)
