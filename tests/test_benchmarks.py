@@ -211,3 +211,21 @@ def test_precision_ceiling_holds_a_stored_pose_precisely_and_counts_the_share(tm
             tool.main([*argv, "--out", str(tmp_path / "n")])
         error = capsys.readouterr().err.strip().splitlines()
         assert stopped.value.code == 2 and message in error[-1]
+
+
+def test_the_profile_counts_each_second_of_a_run_once_and_projects_the_main_job(tmp_path):
+    """A tiny run timed by part: every part measured, none negative, together no more than the run,
+    the learner's compile apart from its updates, and the environment's floor beside it."""
+    tool = load_tool("profile_main_job")
+    result = tool.main(["--steps", "400", "--floor-steps", "50", "--json", str(tmp_path / "p.json"),
+                        "--hidden-sizes", "16,16", "--batch-size", "16", "--min-replay-size", "50",
+                        "--num-eval-targets", "1", "--final-eval-targets", "1", "--new-targets", "1",
+                        "--track-task", ""])
+    seconds, calls = result["seconds"], result["calls"]
+    assert set(seconds) == set(tool.PARTS) and all(value >= 0 for value in seconds.values())
+    assert result["other_seconds"] >= 0 and sum(seconds.values()) <= result["total_seconds"]
+    assert calls["compiling"] == 1 and calls["learner"] > 10 and calls["environment"] > 400
+    assert calls["evaluation"] >= 3 and result["floor_steps_per_second"] > 0
+    assert json.load(open(tmp_path / "p.json"))["steps"] == 400
+    from agents.sac.learning import SACLearner
+    assert SACLearner.step.__name__ == "step"  # the timers are taken off again
