@@ -226,6 +226,10 @@ def test_the_profile_counts_each_second_of_a_run_once_and_projects_the_main_job(
     assert result["other_seconds"] >= 0 and sum(seconds.values()) <= result["total_seconds"]
     assert calls["compiling"] == 1 and calls["learner"] > 10 and calls["environment"] > 400
     assert calls["evaluation"] >= 3 and result["floor_steps_per_second"] > 0
-    assert json.load(open(tmp_path / "p.json"))["steps"] == 400
+    written = json.load(open(tmp_path / "p.json"))
+    assert written["steps"] == 400
+    record = results_page.make_record("profile", str(tmp_path / "p.json"), "Profile", date="2026-12-07")
+    ratios = {row["what"]: row["value"] for row in record["data"]["ratios"]}  # a speed record of ratios
+    assert ratios["projected run / the environment alone"] > 1.0  # the run costs more than stepping alone
     from agents.sac.learning import SACLearner
     assert SACLearner.step.__name__ == "step"  # the timers are taken off again

@@ -123,18 +123,39 @@ def profile(steps: int, train_args: list) -> dict:
             "other_seconds": total - sum(timers.seconds.values())}
 
 
+def projected(result: dict, main_steps: int) -> dict:
+    """Each part's seconds in a run of ``main_steps``: training's parts scale with the steps, the
+    evaluations, the compile and the building do not."""
+    scale = main_steps / result["steps"]
+    parts = {part: result["seconds"][part] * (scale if part in TRAINING_PARTS else 1.0) for part in PARTS}
+    return {**parts, "building, other": result["other_seconds"]}
+
+
+def speed_record(result: dict, floor: float, main_steps: int) -> dict:
+    """The measurement as a speed benchmark's record (tools/results_speed.py): the projected seconds
+    of each part, and each against the environment alone over the same steps, measured in the same run."""
+    parts, alone = projected(result, main_steps), main_steps / floor
+    return {"benchmark": "speed",
+            "description": f"one curriculum run of robostrich-train ({result['steps']:,} control steps, the main "
+                           f"job's settings) timed by part and projected to {main_steps:,} steps, against the "
+                           "environment alone (lesson 3 stepped with random inputs) over as many steps",
+            "rates": [{"what": f"{part}, projected", "value": seconds, "unit": "s"} for part, seconds in parts.items()]
+            + [{"what": "the environment alone", "value": floor, "unit": "control steps/s"}],
+            "ratios": [{"what": "projected run / the environment alone", "value": sum(parts.values()) / alone}]
+            + [{"what": f"{part} / the environment alone", "value": seconds / alone}
+               for part, seconds in parts.items()]}
+
+
 def report(result: dict, floor: float, main_steps: int) -> list:
     """The table's lines: each part's seconds and share, and the projection to ``main_steps``."""
-    scale = main_steps / result["steps"]
-    projected = {part: result["seconds"][part] * (scale if part in TRAINING_PARTS else 1.0) for part in PARTS}
-    projected["building, other"] = result["other_seconds"]
+    parts = projected(result, main_steps)
     lines = [f"one curriculum run of {result['steps']:,} control steps: {result['total_seconds']:.1f} s",
              f"| part | seconds | share | projected to {main_steps:,} steps (s) |", "|---|---|---|---|"]
     measured = {**result["seconds"], "building, other": result["other_seconds"]}
     for part, seconds in measured.items():
         lines.append(f"| {part} | {seconds:.1f} | {100 * seconds / result['total_seconds']:.0f} % | "
-                     f"{projected[part]:.0f} |")
-    lines.append(f"projected run: {sum(projected.values()) / 60:.1f} min; the environment alone (the floor): "
+                     f"{parts[part]:.0f} |")
+    lines.append(f"projected run: {sum(parts.values()) / 60:.1f} min; the environment alone (the floor): "
                  f"{floor:,.0f} control steps/s, {main_steps / floor:.0f} s for {main_steps:,} steps")
     return lines
 
@@ -152,7 +173,7 @@ def main(argv=None) -> dict:
     floor = environment_floor(args.floor_steps)
     main_steps = MAIN_JOB_STEPS["robostrich"]
     print("\n".join(report(result, floor, main_steps)))
-    result.update(floor_steps_per_second=floor, main_job_steps=main_steps,
+    result.update(floor_steps_per_second=floor, main_job_steps=main_steps, **speed_record(result, floor, main_steps),
                   command=" ".join(["python", "tools/profile_main_job.py", *(sys.argv[1:] if argv is None else argv)]))
     if args.json:
         atomic_files.write_json(args.json, result)
