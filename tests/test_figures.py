@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from agents.robostrich import figures
-from agents.robostrich.evaluate import evaluation
+from agents.robostrich.evaluate import episodes
 from agents.replay import ObservationFlattener
 from agents.robostrich.domain_run import make_environment
 from robostrich_suite.studies import movement, movement_figure, walk, walk_figure
@@ -138,12 +138,12 @@ def passive_arm_reports():
     actor = ZeroTendons()
     records, steps = [], 0
     for task in ("lesson1", "lesson2"):
-        report = evaluation.evaluate_heldout(actor, flattener, "robostrich", task, num_targets=2)
+        report = episodes.evaluate_heldout(actor, flattener, "robostrich", task, num_targets=2)
         for episode in report["episodes"]:
             steps += episode["steps"]
             records.append(dict(env_steps=steps, task=task, **{k: episode[k] for k in ("return", "success")}))
     evals = [dict(env_steps=steps, summary=report["summary"])]
-    track = evaluation.evaluate_track(actor, flattener)
+    track = episodes.evaluate_track(actor, flattener)
     return {"records": records, "evals": evals, "boundary": records[1]["env_steps"], "track": track}
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from dm_env import specs
 
-from agents.robostrich.evaluate import evaluation
+from agents.robostrich.evaluate import episodes, evaluation
 from agents.robostrich.domain_run import DomainRun, make_environment, parse_plan
 from agents.robostrich.domains import Domain
 from agents.robostrich.lookup import LookupPolicy, lookup_table
@@ -39,7 +39,7 @@ def test_lookup_table_holds_no_pose_at_a_heldout_target():
 def test_lookup_holds_a_stored_training_pose(flattener):
     policy = LookupPolicy(flattener)
     target = targets.training_targets()[0]
-    report = evaluation.evaluate_heldout(policy, flattener, "robostrich", "lesson2", targets=target[None])
+    report = episodes.evaluate_heldout(policy, flattener, "robostrich", "lesson2", targets=target[None])
     episode = report["episodes"][0]
     assert episode["success"], episode
     assert episode["final_position_error"] < 0.01 and episode["final_attitude_error"] < 5.0, episode
@@ -50,7 +50,7 @@ def test_lookup_holds_a_stored_training_pose(flattener):
 def test_precise_success_is_the_share_within_1cm_and_2deg(flattener):
     """The stored poses are level only within the paper's 5 deg: holding them is a success at
     the paper's tolerance, but rarely a precise reach, which evaluations report beside it."""
-    report = evaluation.evaluate_heldout(LookupPolicy(flattener), flattener, "robostrich", "lesson2",
+    report = episodes.evaluate_heldout(LookupPolicy(flattener), flattener, "robostrich", "lesson2",
                                          targets=targets.training_targets()[:6])
     within = [e["final_position_error"] <= 0.01 and abs(e["final_attitude_error"]) <= 2.0
               for e in report["episodes"]]
@@ -68,7 +68,7 @@ def test_lookup_needs_a_target_position():
 def test_heldout_moving_starts_from_poses_holding_other_targets(flattener):
     policy = LookupPolicy(flattener)
     target = targets.heldout_targets()[:1]
-    report = evaluation.evaluate_heldout_moving(policy, flattener, "robostrich", targets=target)
+    report = episodes.evaluate_heldout_moving(policy, flattener, "robostrich", targets=target)
     starts, _ = Domain("robostrich").moving_starts()
     assert report["summary"]["episodes"] == 3 and [e["start"] for e in report["episodes"]] == [0, 1, 2]
     assert distances(starts, targets.training_targets()).min(axis=1).max() == 0.0  # starts are training targets
@@ -86,7 +86,7 @@ def test_one_hold_per_moving_start_scores_every_target_as_a_hold_before_each_tar
     from robostrich_suite import policies
     from robostrich_suite.tasks.measurement import measure
     policy, chosen = policies.load_policy("robostrich"), targets.heldout_targets()[:2]
-    report = evaluation.evaluate_heldout_moving(policy, flattener, "robostrich", targets=chosen)
+    report = episodes.evaluate_heldout_moving(policy, flattener, "robostrich", targets=chosen)
     env = make_environment("robostrich", "lesson3", 30_000, target_pool=chosen[:1])
     expected = []
     for start, control in zip(*Domain("robostrich").moving_starts()):
@@ -99,7 +99,7 @@ def test_one_hold_per_moving_start_scores_every_target_as_a_hold_before_each_tar
             held = measure(env)
             env.task.set_initial_state("continue")
             env.task.set_target_pool(target)
-            row = evaluation._episode_summary(evaluation.rollout(env, policy, flattener))
+            row = episodes._episode_summary(episodes.rollout(env, policy, flattener))
             expected.append({**row, "start_position_error": held.position_error})
     assert len(report["episodes"]) == len(expected) == 6
     for got, want in zip(report["episodes"], expected):
@@ -139,8 +139,8 @@ def test_evaluation_judges_success_with_the_tasks_own_tolerances():
         env = robostrich_suite.load("robostrich", "lesson2", task_kwargs=dict(
             random=0, target_pool=target, position_tolerance=tolerance))
         flattener = ObservationFlattener(env.observation_spec())
-        series = evaluation.rollout(env, LookupPolicy(flattener), flattener)
-        results[tolerance] = evaluation._episode_summary(series)
+        series = episodes.rollout(env, LookupPolicy(flattener), flattener)
+        results[tolerance] = episodes._episode_summary(series)
     assert results[0.05]["success"] and results[0.05]["tolerances"][0] == 0.05
     assert not results[1e-4]["success"] and results[1e-4]["tolerances"][0] == 1e-4
 
@@ -173,8 +173,8 @@ def test_untrained_residual_agent_is_the_lookup(flattener, tmp_path):
     run = DomainRun(parse_plan("lesson2:100"), config, seed=0, run_dir=str(tmp_path / "run"), residual_scale=0.25)
     actor = SACBuilder.make_eval_actor(run.loop)
     target = targets.heldout_targets()[:2]
-    agent = evaluation.evaluate_heldout(actor, run.loop.flattener, "robostrich", "lesson2", targets=target)
-    base = evaluation.evaluate_heldout(LookupPolicy(flattener), flattener, "robostrich", "lesson2", targets=target)
+    agent = episodes.evaluate_heldout(actor, run.loop.flattener, "robostrich", "lesson2", targets=target)
+    base = episodes.evaluate_heldout(LookupPolicy(flattener), flattener, "robostrich", "lesson2", targets=target)
     assert len(agent["episodes"]) == len(base["episodes"]) == 2
     for a, b in zip(agent["episodes"], base["episodes"]):
         assert a["final_position_error"] == pytest.approx(b["final_position_error"], abs=1e-9)

@@ -12,7 +12,7 @@ from conftest import console_script
 import robostrich_suite
 from agents.robostrich.domain_run import DomainRun, parse_plan
 from agents.robostrich.domains import domain_of
-from agents.robostrich.evaluate.evaluation import evaluate_track
+from agents.robostrich.evaluate.episodes import evaluate_track
 from agents.robostrich.evaluate.policy_export import export_policy
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig

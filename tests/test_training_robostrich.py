@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from agents.robostrich.evaluate import command as evaluate_command
-from agents.robostrich.evaluate import evaluation
+from agents.robostrich.evaluate import episodes
 from agents.robostrich.domain_run import DomainRun, parse_plan
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
@@ -24,7 +24,7 @@ STEPS = 12_000
 def position_report(run):
     """Held-out targets, lesson 1 criterion: final head position within 0.05 m (attitude is not trained yet)."""
     actor = SACBuilder.make_eval_actor(run.loop)
-    report = evaluation.evaluate_heldout(actor, run.loop.flattener, "robostrich", "lesson1")
+    report = episodes.evaluate_heldout(actor, run.loop.flattener, "robostrich", "lesson1")
     errors = np.array([e["final_position_error"] for e in report["episodes"]])
     return float(np.mean(errors <= 0.05)), float(np.median(errors))
 

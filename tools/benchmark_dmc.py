@@ -16,7 +16,7 @@ import sys
 import time
 from collections import deque
 from agents.robostrich.domain_run import DomainRun, parse_plan
-from agents.robostrich.evaluate import evaluation
+from agents.robostrich.evaluate import episodes
 from agents.robostrich.train.main_job import MAIN_JOB_SAC  # robostrich-train's agent, these flags on top
 from agents.sac.builder import SACBuilder
 from robostrich_suite.atomic_files import write_text  # the project's one atomic writer
@@ -156,7 +156,7 @@ def train_and_evaluate(task, seed, steps, eval_at, config, args, progress, on_ro
         while pending and pending[0] <= r.loop.env_steps:
             step = pending.pop(0)
             actor = SACBuilder.make_eval_actor(r.loop)
-            report = evaluation.evaluate_heldout(actor, r.loop.flattener, domain, task_name,
+            report = episodes.evaluate_heldout(actor, r.loop.flattener, domain, task_name,
                                                  num_targets=args.eval_episodes, action_repeat=config.action_repeat)
             s = report["summary"]
             on_row({"task": task, "seed": seed, "eval_step": step, "env_steps": r.loop.env_steps,

@@ -25,7 +25,7 @@ from dm_control.rl import control
 from agents.actors import Actor
 from agents.replay import ReplayBuffer
 from agents.robostrich.domains import Domain
-from agents.robostrich.evaluate import evaluation
+from agents.robostrich.evaluate import episodes
 from agents.robostrich.train import command as training
 from agents.robostrich.train.main_job import MAIN_JOB_STEPS
 from agents.sac.learning import SACLearner
@@ -107,9 +107,9 @@ def profile(steps: int, train_args: list) -> dict:
                                    (Actor, "policy_action", "acting"), (Actor, "select_action", "acting"),
                                    (ReplayBuffer, "add", "replay"), (ReplayBuffer, "sample_stack", "replay"),
                                    (Actor, "update", "learner"),
-                                   (evaluation, "evaluate_heldout", "evaluation"),
-                                   (evaluation, "evaluate_heldout_moving", "evaluation"),
-                                   (evaluation, "evaluate_track", "evaluation")):
+                                   (episodes, "evaluate_heldout", "evaluation"),
+                                   (episodes, "evaluate_heldout_moving", "evaluation"),
+                                   (episodes, "evaluate_track", "evaluation")):
         timers.wrap(owner, attribute, name)
     try:
         with tempfile.TemporaryDirectory() as out:

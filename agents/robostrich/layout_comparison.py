@@ -10,7 +10,7 @@ import numpy as np
 
 import robostrich_suite
 from agents.replay import ObservationFlattener
-from agents.robostrich.evaluate import evaluation
+from agents.robostrich.evaluate import episodes, evaluation
 from agents.robostrich.lookup import lookup_table, LookupPolicy
 from agents.robostrich.train.main_job import FIXED_START_ARM_TASK_KWARGS, MAIN_JOB_SAC
 from agents.robostrich.domain_run import DomainRun, make_environment, parse_plan
@@ -30,11 +30,11 @@ def heldout_success(case: layout_compare.Case, heldout: np.ndarray, make_actor, 
                                                  tendon_layout=case.layout, target_pool=heldout[:1]))
     flattener = ObservationFlattener(env.observation_spec())
     actor = make_actor(flattener)
-    episodes = []
+    rows = []
     for target in heldout:
         env.task.target_pool = np.asarray(target, np.float64)[None]
-        episodes.append(evaluation._episode_summary(evaluation.rollout(env, actor, flattener)))
-    return evaluation.summarize(episodes)
+        rows.append(episodes._episode_summary(episodes.rollout(env, actor, flattener)))
+    return episodes.summarize(rows)
 
 
 def lookup_success(case, target_path: pathlib.Path, options) -> dict:

@@ -15,7 +15,7 @@ import re
 from agents.robostrich import figures
 from agents.robostrich.applications import figures as application_figures
 from agents.robostrich.applications import rollouts as applications
-from agents.robostrich.evaluate import evaluation
+from agents.robostrich.evaluate import episodes, evaluation
 from agents.robostrich.applications import stabilization
 from agents.robostrich.domains import domain_of, TRACK_TASK
 from agents.robostrich.recording import open_recorder
@@ -38,7 +38,7 @@ def play_track(policy, domain, args, label: str) -> tuple:
     """`track` (Fig. 7): (its report, the files written in args.out: figure, recording)."""
     written = [f"{label}_track.png"] + ([] if args.no_rerun else [f"{label}_track.rrd"])
     with open_recorder(None if args.no_rerun else os.path.join(args.out, written[-1]), f"{label} track") as recorder:
-        report = evaluation.evaluate_track(policy, policy.flatten, domain, TRACK_TASK, recorder=recorder)
+        report = episodes.evaluate_track(policy, policy.flatten, domain, TRACK_TASK, recorder=recorder)
     figures.plot_track({label: report}, os.path.join(args.out, written[0]))
     print(f"track    {evaluation.outcome_text('track', report['summary'])}", flush=True)
     return report, written
@@ -82,7 +82,7 @@ def main(argv=None) -> dict:
     os.makedirs(args.out, exist_ok=True)
     print(f"{args.policy} ({domain.describe()}, seed {policy.info.get('seed')}, "
           f"{policy.info.get('env_steps')} control steps of training)", flush=True)
-    reports = {"heldout": evaluation.evaluate_heldout(policy, policy.flatten, domain, heldout_task, args.num_targets)}
+    reports = {"heldout": episodes.evaluate_heldout(policy, policy.flatten, domain, heldout_task, args.num_targets)}
     print(f"heldout  {evaluation.outcome_text('heldout', reports['heldout']['summary'])}", flush=True)
     second, play = ("head_stabilize", play_stabilize) if domain.on_quadruped else ("track", play_track)
     label = policy_label(args.policy)

@@ -15,7 +15,7 @@ from typing import Optional
 import numpy as np
 
 from agents.replay import ObservationFlattener
-from agents.robostrich.evaluate import evaluation
+from agents.robostrich.evaluate import episodes, evaluation
 from agents.robostrich.domains import Domain
 
 PEERS = {"sac": "SAC", "tqc": "TQC", "crossq": "CrossQ"}  # flag name -> sbx class
@@ -120,7 +120,7 @@ def train(spec: PeerSpec) -> dict:
             model.set_env(env)
             lesson_now = lesson
         model.learn(steps, reset_num_timesteps=False)
-        report = evaluation.evaluate_heldout(PeerActor(model, env), flattener, domain, spec.heldout_task,
+        report = episodes.evaluate_heldout(PeerActor(model, env), flattener, domain, spec.heldout_task,
                                              spec.num_eval_targets)
         curve.append({"env_steps": int(model.num_timesteps), "summary": report["summary"]})
         with open(os.path.join(spec.out, "evals.jsonl"), "a") as f:

@@ -16,7 +16,7 @@ import os
 
 
 from agents.replay import ObservationFlattener
-from agents.robostrich.evaluate import evaluation
+from agents.robostrich.evaluate import episodes, evaluation
 from agents.robostrich.robustness import figure as robustness_figure
 from agents.robostrich.domains import as_domain, Domain, domain_of
 from agents.robostrich.lookup import LABEL, LookupPolicy
@@ -117,10 +117,10 @@ def evaluate(evaluated: Evaluated, perturbation, num_targets) -> dict:
     """The held-out evaluation on the perturbed robot: {kind: its summary's main numbers}."""
     domain = PerturbedDomain(evaluated.domain, perturbation)
     task = evaluation.default_heldout_task(domain, "track")
-    reports = {"heldout": evaluation.evaluate_heldout(evaluated.actor, evaluated.flattener, domain, task,
+    reports = {"heldout": episodes.evaluate_heldout(evaluated.actor, evaluated.flattener, domain, task,
                                                       num_targets, action_repeat=evaluated.action_repeat)}
     if domain.has_moving_starts:
-        reports["heldout_moving"] = evaluation.evaluate_heldout_moving(
+        reports["heldout_moving"] = episodes.evaluate_heldout_moving(
             evaluated.actor, evaluated.flattener, domain, num_targets, action_repeat=evaluated.action_repeat)
     return {kind: {k: report["summary"][k] for k in SUMMARY_FIELDS} for kind, report in reports.items()}
 

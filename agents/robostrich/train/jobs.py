@@ -10,7 +10,7 @@ from typing import Optional
 import numpy as np
 
 from agents.curriculum import read_records
-from agents.robostrich.evaluate import evaluation
+from agents.robostrich.evaluate import episodes, evaluation
 from agents.robostrich.train import transfer
 from agents.robostrich.domains import Domain
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
@@ -115,7 +115,7 @@ def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
             actor = SACBuilder.make_eval_actor(r.loop)
             lesson_end = r.loop.env_steps in step_boundaries(r.plan)[:-1]  # evaluated on every held-out target
             targets = final_targets(job) if lesson_end else job.num_eval_targets
-            report = evaluation.evaluate_heldout(actor, r.loop.flattener, job.domain, job.heldout_task,
+            report = episodes.evaluate_heldout(actor, r.loop.flattener, job.domain, job.heldout_task,
                                                  targets, action_repeat=config.action_repeat)
             record = {"env_steps": r.loop.env_steps, "lessons_completed": r.lesson_index, "summary": report["summary"]}
             if lesson_end:
