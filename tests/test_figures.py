@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from agents.robostrich import figures
+from agents.robostrich.domains import as_domain
 from agents.robostrich.evaluate import episodes
 from agents.replay import ObservationFlattener
-from agents.robostrich.domain_run import make_environment
 from robostrich_suite.studies import movement, movement_figure, walk, walk_figure
 from robostrich_suite.tasks import quadruped_tasks
 
@@ -134,7 +134,7 @@ def test_walk_legends_sit_beside_the_data_not_on_it(walk_series):
 @pytest.fixture(scope="module")
 def passive_arm_reports():
     """Learning-curve records and a track report of the passive arm, from real episodes."""
-    flattener = ObservationFlattener(make_environment("robostrich", "lesson2", 0).observation_spec())
+    flattener = ObservationFlattener(as_domain("robostrich").make_environment("lesson2", 0).observation_spec())
     actor = ZeroTendons()
     records, steps = [], 0
     for task in ("lesson1", "lesson2"):

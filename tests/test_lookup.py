@@ -8,8 +8,8 @@ import pytest
 from dm_env import specs
 
 from agents.robostrich.evaluate import episodes, evaluation
-from agents.robostrich.domain_run import DomainRun, make_environment, parse_plan
-from agents.robostrich.domains import Domain
+from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domains import Domain, as_domain
 from agents.robostrich.lookup import LookupPolicy, lookup_table
 from agents.replay import ObservationFlattener
 from agents.sac.builder import SACBuilder
@@ -19,7 +19,7 @@ from robostrich_suite import targets
 
 @pytest.fixture(scope="module")
 def flattener():
-    return ObservationFlattener(make_environment("robostrich", "lesson2", 0).observation_spec())
+    return ObservationFlattener(as_domain("robostrich").make_environment("lesson2", 0).observation_spec())
 
 
 def distances(a, b):
@@ -87,7 +87,7 @@ def test_one_hold_per_moving_start_scores_every_target_as_a_hold_before_each_tar
     from robostrich_suite.tasks.measurement import measure
     policy, chosen = policies.load_policy("robostrich"), targets.heldout_targets()[:2]
     report = episodes.evaluate_heldout_moving(policy, flattener, "robostrich", targets=chosen)
-    env = make_environment("robostrich", "lesson3", 30_000, target_pool=chosen[:1])
+    env = as_domain("robostrich").make_environment("lesson3", 30_000, target_pool=chosen[:1])
     expected = []
     for start, control in zip(*Domain("robostrich").moving_starts()):
         for target in chosen:  # as the evaluation ran before: hold the start before every target
@@ -147,7 +147,7 @@ def test_evaluation_judges_success_with_the_tasks_own_tolerances():
 
 def test_residual_adapter_offsets_the_lookup_by_a_bounded_correction(flattener, tmp_path):
     from agents.actors import ResidualAdapter
-    env = make_environment("robostrich", "lesson2", 0)
+    env = as_domain("robostrich").make_environment("lesson2", 0)
     spec = env.action_spec()
     lookup = LookupPolicy(flattener)
     adapter = ResidualAdapter(spec, lookup, scale=0.25)
@@ -179,13 +179,13 @@ def test_untrained_residual_agent_is_the_lookup(flattener, tmp_path):
     for a, b in zip(agent["episodes"], base["episodes"]):
         assert a["final_position_error"] == pytest.approx(b["final_position_error"], abs=1e-9)
     run.run()  # training moves it: after 100 steps with updates the policy is no longer exactly zero
-    obs = run.loop.flattener(make_environment("robostrich", "lesson2", 0).reset().observation)
+    obs = run.loop.flattener(as_domain("robostrich").make_environment("lesson2", 0).reset().observation)
     assert np.abs(SACBuilder.make_eval_actor(run.loop).policy_action(obs)).max() > 0
 
 
 def test_continued_episode_keeps_the_servo_command():
     """Lesson 3 starts where the last episode ended, inputs included (a real servo keeps its command)."""
-    env = make_environment("robostrich", "lesson3", 0)
+    env = as_domain("robostrich").make_environment("lesson3", 0)
     spec = env.action_spec()
     held = spec.minimum + 0.6 * (spec.maximum - spec.minimum)
     timestep = env.reset()

@@ -25,8 +25,8 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
-from agents.robostrich.domain_run import make_environment
 from agents.robostrich.train.main_job import MAIN_JOB_SAC
+from agents.robostrich.domains import as_domain
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from agents.sac.learning import SACLearner, Transitions, init_state
@@ -123,7 +123,7 @@ def main(argv=None):
     p.add_argument("--action-repeat", type=int, default=5, help="action repeat of the last loop measured")
     p.add_argument("--json", default=None, help="also write the rates and ratios here (a results record's input)")
     args = p.parse_args(argv)
-    env = make_environment(args.domain, args.task, 0)
+    env = as_domain(args.domain).make_environment(args.task, 0)
     config = dataclasses.replace(MAIN_JOB_SAC,  # robostrich-train's agent, these on top
                                  batch_size=args.batch, hidden_sizes=tuple(int(h) for h in args.hidden_sizes.split(",")),
                                  updates_per_call=args.updates_per_call, min_replay_size=0,
@@ -175,7 +175,7 @@ def main(argv=None):
     policy_apply = networks.policy_apply  # eager haiku apply, the obvious first version
     params = learner.policy_params
     adapter = loop.actor.adapter
-    plain_env = make_environment(args.domain, args.task, 1)
+    plain_env = as_domain(args.domain).make_environment(args.task, 1)
     plain_state = {"ts": plain_env.reset(), "key": jax.random.PRNGKey(0), "transitions": []}
 
     def plain_loop():
@@ -189,7 +189,7 @@ def main(argv=None):
             plain_state["transitions"].append((ts.observation, a, nts.reward, nts.discount, nts.observation))
             plain_state["ts"] = plain_env.reset() if nts.last() else nts
 
-    raw_env = make_environment(args.domain, args.task, 2)
+    raw_env = as_domain(args.domain).make_environment(args.task, 2)
     raw_env.reset()
     action = adapter.to_env(np.zeros(act_size))
 
@@ -200,7 +200,7 @@ def main(argv=None):
 
     repeat_loop = SACBuilder(SACConfig(**{**loop.config.to_dict(), "action_repeat": args.action_repeat,
                                           "hidden_sizes": config.hidden_sizes})).make_components(
-        make_environment(args.domain, args.task, 3), seed=0)
+        as_domain(args.domain).make_environment(args.task, 3), seed=0)
     repeat_loop.actor.update(params)
     rates = best_rates({"ours": lambda: loop.run(chunk), "plain": plain_loop, "raw": raw,
                         "ours_repeat": lambda: repeat_loop.run(chunk)}, args.seconds * 4)

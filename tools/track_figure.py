@@ -11,7 +11,7 @@ import sys
 
 from agents.replay import ObservationFlattener
 from agents.robostrich import figures
-from agents.robostrich.evaluate import episodes, evaluation
+from agents.robostrich.evaluate import episodes
 from agents.robostrich.domains import TRACK_TASK, as_domain, domain_of
 from agents.robostrich.lookup import LookupPolicy
 from robostrich_suite import cli as cli_lib
@@ -27,7 +27,7 @@ def main(argv=None) -> dict:
     policy = policies.load_policy(args.policy)
     domain = domain_of(policy.info)
     reports = {"curriculum": episodes.evaluate_track(policy, policy.flatten, domain, TRACK_TASK)}
-    flattener = ObservationFlattener(evaluation.make_environment(domain, TRACK_TASK, 0).observation_spec())
+    flattener = ObservationFlattener(as_domain(domain).make_environment(TRACK_TASK, 0).observation_spec())
     reports["lookup"] = episodes.evaluate_track(LookupPolicy(flattener, domain.lookup_table()), flattener,
                                                   domain, TRACK_TASK)
     steps = policy.info.get("env_steps")

@@ -33,12 +33,6 @@ def parse_plan(text: str, default_domain: str = DEFAULT_DOMAIN):
     return curriculum.parse_plan(text, default_domain)
 
 
-def make_environment(domain, task: str, seed: int, **task_kwargs):
-    """robostrich_suite.load for the arm domains, dm_control.suite.load otherwise (agents/robostrich/domains.py);
-    `domain` is a name or a Domain (which may carry a tendon layout)."""
-    return as_domain(domain).make_environment(task, seed, **task_kwargs)
-
-
 def _is_arm_plan(plan) -> bool:
     return bool(plan) and all(as_domain(lesson.domain).is_arm for lesson in plan)
 
@@ -113,14 +107,15 @@ class DomainRun(curriculum.CurriculumRun):
     """A CurriculumRun whose lessons name domains of agents/robostrich/domains.py."""
 
     def __init__(self, plan: Sequence[Lesson], config: SACConfig, seed: int, run_dir: str,
-                 checkpoint_every: int = 10_000, env_factory: Callable = make_environment, name: str = "run",
+                 checkpoint_every: int = 10_000, env_factory: Optional[Callable] = None, name: str = "run",
                  task_kwargs: Optional[dict] = None, layout: Optional[str] = None,
                  init_from: Optional[str] = None, keep_lesson_checkpoints: bool = False,
                  lessons: LessonSettings = DEFAULT_LESSONS, residual_scale: float = 0.0):
         """``task_kwargs`` go to every lesson's task (e.g. eq. 10's ``weights``); ``layout`` names a
         built-in tendon layout of the arm domains (its own targets come with it); ``init_from`` is the
         content hash of the checkpoint whose learner this run starts from (transfer.initialize puts
-        it there); ``env_factory(domain, task, seed, **task_kwargs)`` builds a lesson's environment;
+        it there); ``env_factory(domain, task, seed, **task_kwargs)``, if given, builds a lesson's environment
+        instead of the domain's own ``make_environment``;
         ``residual_scale`` > 0 trains a residual on the first lesson's lookup."""
         check_lesson_names(plan, config, lessons, layout)  # and an unknown layout fails here, not mid-run
         self.task_kwargs = dict(task_kwargs or {})
@@ -145,6 +140,8 @@ class DomainRun(curriculum.CurriculumRun):
     current_fingerprint = staticmethod(current_fingerprint)
 
     def _make_lesson_environment(self, lesson: Lesson, seed: int):
+        if self.env_factory is None:
+            return self.domain(lesson).make_environment(lesson.task, seed, **self.task_kwargs)
         return self.env_factory(self.domain(lesson), lesson.task, seed, **self.task_kwargs)
 
     def _residual(self, plan):

@@ -10,10 +10,11 @@ import numpy as np
 
 import robostrich_suite
 from agents.replay import ObservationFlattener
+from agents.robostrich.domains import as_domain
 from agents.robostrich.evaluate import episodes, evaluation
 from agents.robostrich.lookup import lookup_table, LookupPolicy
 from agents.robostrich.train.main_job import FIXED_START_ARM_TASK_KWARGS, MAIN_JOB_SAC
-from agents.robostrich.domain_run import DomainRun, make_environment, parse_plan
+from agents.robostrich.domain_run import DomainRun, parse_plan
 from agents.sac.builder import SACBuilder
 from robostrich_suite import targets
 from robostrich_suite import cli as cli_lib
@@ -56,7 +57,7 @@ def curriculum_success(case, target_path: pathlib.Path, options, steps: int = DE
                       target_pool=targets.training_targets(target_path))
 
     def env_factory(domain, task, env_seed, **task_kwargs):  # the arm stays out of the fingerprint
-        return make_environment(domain, task, env_seed, **arm_kwargs, **task_kwargs)
+        return as_domain(domain).make_environment(task, env_seed, **arm_kwargs, **task_kwargs)
 
     per_lesson = max(steps // 3, 1)
     plan = parse_plan(",".join(f"lesson{i}:{per_lesson}" for i in (1, 2, 3)))

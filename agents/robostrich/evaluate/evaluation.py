@@ -21,7 +21,7 @@ from agents.robostrich.domains import as_domain, domain_of, TRACK_TASK
 from agents.robostrich.lookup import LABEL, LookupPolicy
 from agents.robostrich.evaluate import episodes, lookup_cache
 from agents.robostrich.recording import open_recorder
-from agents.robostrich.domain_run import DomainRun, current_fingerprint, make_environment, parse_plan
+from agents.robostrich.domain_run import DomainRun, current_fingerprint, parse_plan
 from agents.sac.config import SACConfig
 from robostrich_suite import atomic_files, parsing
 from robostrich_suite import cli as cli_lib
@@ -45,7 +45,7 @@ def check_heldout_task(domain, task: str) -> str:
     try:
         domain.check_task(task)
         if domain.is_arm:
-            make_environment(domain, task, 0, target_pool=domain.heldout_targets(1)).close()
+            as_domain(domain).make_environment(task, 0, target_pool=domain.heldout_targets(1)).close()
     except (TypeError, ValueError) as error:
         raise ValueError(f"--heldout-task {task!r} cannot be evaluated on held-out targets: {error}") from None
     return task
@@ -165,7 +165,7 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
                 on_episode()
         return {name[len(LABEL) + 1:-len(".json")]: parsing.read_json(os.path.join(out_dir, name))
                 for name in restored if name.endswith(".json")}
-    flattener = ObservationFlattener(make_environment(domain, heldout_task, 0).observation_spec())
+    flattener = ObservationFlattener(as_domain(domain).make_environment(heldout_task, 0).observation_spec())
     reports = evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain,
                              heldout_task, track_task, num_targets, env_steps=0, record=record, action_repeat=1,
                              on_episode=on_episode, new_targets=new_targets)
