@@ -9,7 +9,7 @@ Every run trains for --steps control steps on the main job's task options and la
 either on the final lesson alone ('final') or through the main job's lessons and shares
 ('lessons': the same agent and replay, the next lesson's environment); our curriculum goes
 through the lessons, our plain SAC trains the final lesson (robostrich-train at this budget).
-All are scored by agents/robostrich/evaluate/evaluation.py: held-out success from the fixed start every
+All are scored by agents/robostrich/evaluate/episodes.py: held-out success from the fixed start every
 --eval-every steps (the curves), then every held-out target from the fixed and from moving
 starts and `track`. --workers runs at a time, one core each; a finished run is not re-run, and
 --record-only writes the record from the runs finished so far.
