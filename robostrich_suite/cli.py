@@ -22,10 +22,10 @@ limits below, named in the error), so no flag asks for days or terabytes by acci
 from __future__ import annotations
 
 import argparse
-import re
 import contextlib
 import gc
 import math
+import re
 import signal
 import sys
 import threading

@@ -25,6 +25,7 @@ import sys
 import tempfile
 import time
 import urllib.parse
+
 from robostrich_suite import cli as cli_lib
 
 HOST = "127.0.0.1"

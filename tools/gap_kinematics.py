@@ -29,8 +29,7 @@ import numpy as np
 
 from robostrich_suite.studies.gap_column import SAMPLES_PER_CAPSULE  # points per capsule
 from robostrich_suite import targets
-from robostrich_suite.atomic_files import save_figure
-from robostrich_suite.atomic_files import write_text
+from robostrich_suite.atomic_files import save_figure, write_text
 from robostrich_suite.model import layouts
 from robostrich_suite.studies import gap_column
 from robostrich_suite.tasks.starts import STORED_START_SETTLE_TIME, hold_before_episode

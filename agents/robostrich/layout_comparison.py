@@ -10,7 +10,6 @@ import numpy as np
 
 import robostrich_suite
 from agents.replay import ObservationFlattener
-from agents.robostrich.domains import as_domain
 from agents.robostrich.evaluate import episodes, evaluation
 from agents.robostrich.lookup import lookup_table, LookupPolicy
 from agents.robostrich.train.main_job import FIXED_START_ARM_TASK_KWARGS, MAIN_JOB_SAC
@@ -57,7 +56,7 @@ def curriculum_success(case, target_path: pathlib.Path, options, steps: int = DE
                       target_pool=targets.training_targets(target_path))
 
     def env_factory(domain, task, env_seed, **task_kwargs):  # the arm stays out of the fingerprint
-        return as_domain(domain).make_environment(task, env_seed, **arm_kwargs, **task_kwargs)
+        return domain.make_environment(task, env_seed, **arm_kwargs, **task_kwargs)
 
     per_lesson = max(steps // 3, 1)
     plan = parse_plan(",".join(f"lesson{i}:{per_lesson}" for i in (1, 2, 3)))

@@ -39,8 +39,7 @@ from robostrich_suite.tasks.conventions import LEVEL_ATTITUDE_DEG, LEVEL_TOLERAN
 from robostrich_suite.studies import gap_column
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import physics as physics_lib
-from robostrich_suite.atomic_files import save_figure
-from robostrich_suite.atomic_files import write_text
+from robostrich_suite.atomic_files import save_figure, write_text
 from robostrich_suite.studies import workspace
 
 MARGIN = 0.002  # m a sought pose keeps its capsules clear of the scene (checked at 0: gap_column.touching)

@@ -283,7 +283,8 @@ def build_parser() -> cli_lib.Parser:
         prog=PROG,
         description="Compare tendon layouts (and passive joint stiffnesses) of the Robostrich "
                     "arm on the same Table 1 links: share of the blue region of Fig. 6 (where the links "
-                    "can put the head level, 90+-5 deg) held level by the tendons (coverage), distinct level targets, rolling/lever attitude ranges, "
+                    "can put the head level, 90+-5 deg) held level by the tendons (coverage), distinct "
+                    "level targets, rolling/lever attitude ranges, "
                     "and, from the agent's side, held-out success of the lookup baseline (and, "
                     "with --train, of a short curriculum run). Writes layouts.md, layouts.csv, layouts.png and "
                     "targets/LAYOUT.npz under --out.",

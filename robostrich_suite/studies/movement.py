@@ -26,8 +26,7 @@ from robostrich_suite.model import arm as arm_lib
 from robostrich_suite import scenes
 from robostrich_suite.studies import movement_figure
 from robostrich_suite.tasks.conventions import CONTROL_TIMESTEP, PHYSICS_TIMESTEP
-from robostrich_suite import rerun_blueprint
-from robostrich_suite import rerun_log
+from robostrich_suite import rerun_blueprint, rerun_log
 
 PATTERNS = ("rolling", "lever")
 SETTLE_TIME = 3.0  # s before the ventral ramps start: the start pose comes to rest

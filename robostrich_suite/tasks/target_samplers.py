@@ -90,10 +90,11 @@ class TargetSampler:
         nearest pool poses, then uniformly within a disk of radius ``jitter`` (m): training that
         meets the poses between the pool's (the reaching task's ``target_between`` and ``target_jitter``)."""
         if between and len(self.pool) > 1:
-            if self._neighbours is None or self._neighbours.shape[1] != min(between, len(self.pool) - 1):
+            k = min(between, len(self.pool) - 1)
+            if self._neighbours is None or self._neighbours.shape[1] != k:  # made once per pool and k
                 distances = np.linalg.norm(self.pool[:, None] - self.pool[None], axis=2)
                 np.fill_diagonal(distances, np.inf)
-                self._neighbours = np.argsort(distances, axis=1)[:, :min(between, len(self.pool) - 1)]
+                self._neighbours = np.argsort(distances, axis=1)[:, :k]
             other = self.pool[self._neighbours[self.index, random.randint(self._neighbours.shape[1])]]
             target = target + random.uniform() * (other - target)
         if jitter:  # uniform over the disk: the radius as the square root of a uniform draw

@@ -132,11 +132,13 @@ def stabilization_table(results: dict, meta: dict) -> str:
 
 def stabilize_main(argv=None) -> dict:
     parser = _parser("Head stabilisation while walking (Sec. 5.2.1, Fig. 9): head height, vertical velocity, "
-                     "distance P_d (the head's desired distance ahead of the trunk centre) and attitude of each policy over 12 s of walking with two trunk-height changes.",
+                     "distance P_d (the head's desired distance ahead of the trunk centre) and attitude of each "
+                     "policy over 12 s of walking with two trunk-height changes.",
                      os.path.join("out", "stabilize"))
     parser.add_argument("--settle", type=cli_lib.seconds(allow_zero=True), default=stabilization.SETTLE,
                         help=f"seconds at the start left out of the metrics (default {stabilization.SETTLE})")
-    parser.add_argument("--distance", type=cli_lib.number(-2, 2, " m"), default=None, help="P_d, the head's desired distance ahead of the trunk centre (m; default the task's)")
+    parser.add_argument("--distance", type=cli_lib.number(-2, 2, " m"), default=None,
+                        help="P_d, the head's desired distance ahead of the trunk centre (m; default the task's)")
     parser.add_argument("--height", type=cli_lib.number(-2, 2, " m"), default=None, help="head height above ground (m; default the task's)")
     args = parser.parse_args(argv)
     if args.time_limit is not None and args.time_limit <= args.settle:

@@ -17,7 +17,7 @@ from agents.robostrich.applications import figures as application_figures
 from agents.robostrich.applications import rollouts as applications
 from agents.robostrich.evaluate import episodes, evaluation
 from agents.robostrich.applications import stabilization
-from agents.robostrich.domains import domain_of, TRACK_TASK, as_domain
+from agents.robostrich.domains import domain_of, TRACK_TASK
 from agents.robostrich.recording import open_recorder
 from robostrich_suite import atomic_files, outputs, policies, web_viewer
 from robostrich_suite import cli as cli_lib
@@ -76,7 +76,7 @@ def main(argv=None) -> dict:
     policy = policies.load_policy(args.policy)
     domain = domain_of(policy.info)
     heldout_task = evaluation.default_heldout_task(domain, TRACK_TASK)
-    env = as_domain(domain).make_environment(heldout_task, 0)
+    env = domain.make_environment(heldout_task, 0)
     policy.check(env)
     env.close()
     os.makedirs(args.out, exist_ok=True)

@@ -45,7 +45,7 @@ def check_heldout_task(domain, task: str) -> str:
     try:
         domain.check_task(task)
         if domain.is_arm:
-            as_domain(domain).make_environment(task, 0, target_pool=domain.heldout_targets(1)).close()
+            domain.make_environment(task, 0, target_pool=domain.heldout_targets(1)).close()
     except (TypeError, ValueError) as error:
         raise ValueError(f"--heldout-task {task!r} cannot be evaluated on held-out targets: {error}") from None
     return task
@@ -165,7 +165,7 @@ def evaluate_lookup(out_dir: str, domain, heldout_task: str, track_task: Optiona
                 on_episode()
         return {name[len(LABEL) + 1:-len(".json")]: parsing.read_json(os.path.join(out_dir, name))
                 for name in restored if name.endswith(".json")}
-    flattener = ObservationFlattener(as_domain(domain).make_environment(heldout_task, 0).observation_spec())
+    flattener = ObservationFlattener(domain.make_environment(heldout_task, 0).observation_spec())
     reports = evaluate_agent(LookupPolicy(flattener, domain.lookup_table()), flattener, out_dir, LABEL, domain,
                              heldout_task, track_task, num_targets, env_steps=0, record=record, action_repeat=1,
                              on_episode=on_episode, new_targets=new_targets)

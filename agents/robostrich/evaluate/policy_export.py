@@ -7,7 +7,6 @@ fingerprint, with the command, seed and run fingerprint that made it.
 import numpy as np
 
 from agents import checkpoint
-from agents.robostrich.domains import as_domain
 from agents.actors import ResidualAdapter
 from agents.robostrich.evaluate.evaluation import default_heldout_task, load_run_from_checkpoint
 from robostrich_suite import policies
@@ -32,7 +31,7 @@ def export_policy(checkpoint_path: str, out_path: str, command: str = "") -> pol
         raise ValueError(f"{checkpoint_path}: the policy acts every {run.config.action_repeat} control steps; "
                          "a policy file acts every step")
     domain = run.domain()
-    env = as_domain(domain).make_environment(default_heldout_task(domain, run.plan[-1].task), 0)
+    env = domain.make_environment(default_heldout_task(domain, run.plan[-1].task), 0)
     spec = env.action_spec()
     hidden, mean = _layers(run.loop.learner.evaluation_params)
     stored = checkpoint.read_fingerprint(checkpoint_path)

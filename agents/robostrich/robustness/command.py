@@ -99,7 +99,7 @@ def load_evaluated(spec: str, label: str) -> Evaluated:
                          run.config.action_repeat, spec)
     policy = policies.load_policy(spec)
     domain = domain_of(policy.info)
-    env = as_domain(domain).make_environment(evaluation.default_heldout_task(domain, "track"), 0)
+    env = domain.make_environment(evaluation.default_heldout_task(domain, "track"), 0)
     policy.check(env)
     env.close()
     return Evaluated(label, policy, policy.flatten, domain, 1, spec)
@@ -107,7 +107,7 @@ def load_evaluated(spec: str, label: str) -> Evaluated:
 
 def lookup_evaluated(domain) -> Evaluated:
     domain = as_domain(domain)
-    env = as_domain(domain).make_environment(evaluation.default_heldout_task(domain, "track"), 0)
+    env = domain.make_environment(evaluation.default_heldout_task(domain, "track"), 0)
     flattener = ObservationFlattener(env.observation_spec())
     env.close()
     return Evaluated(LABEL, LookupPolicy(flattener, domain.lookup_table()), flattener, domain, 1, LABEL)

@@ -24,9 +24,8 @@ from agents.robostrich.evaluate import command as evaluate_command
 from agents.robostrich.evaluate import evaluation
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.robostrich.train.main_job import (DEFAULT_ARM_LAYOUT, DEFAULT_ARM_TASK_KWARGS, DEFAULT_TOTAL_STEPS,
-                                              FRAME_TASK_KWARGS,
-                                        MAIN_JOB_BY_DOMAIN, MAIN_JOB_LESSON_SHARES, MAIN_JOB_SAC, MAIN_JOB_STEPS,
-                                        QUADRUPED_TASK_KWARGS, positive_int)
+                                              FRAME_TASK_KWARGS, MAIN_JOB_BY_DOMAIN, MAIN_JOB_LESSON_SHARES,
+                                              MAIN_JOB_SAC, MAIN_JOB_STEPS, QUADRUPED_TASK_KWARGS, positive_int)
 from agents.robostrich.train.run_directory import check_run_directory, finished_summary, lock_run_directory, previous_init_path
 from agents.robostrich.domain_run import DEFAULT_LESSONS
 from agents.robostrich.train.checks import TrainingSetup, json_object, prepare, randomize_scales
@@ -178,8 +177,8 @@ def start_lines(args, setup: TrainingSetup) -> list:
     main_steps = MAIN_JOB_STEPS.get(setup.domain.name)
     steps = max(sum(l.steps for l in plan) for plan in setup.run_plans.values())
     if main_steps and steps < main_steps:
-        lines.append(f"{steps:,} control steps per run are {100 * steps / main_steps:.2g} % of the main job's {main_steps:,}: "
-                     "expect a weaker policy than docs/results.md reports")
+        lines.append(f"{steps:,} control steps per run are {100 * steps / main_steps:.2g} % of the main job's "
+                     f"{main_steps:,}: expect a weaker policy than docs/results.md reports")
     lines.append("progress: return is the mean return of the last 20 training episodes, reached the share of the "
                  "last 50 that reached their target; each held-out evaluation prints a line as it ends")
     return lines

@@ -16,7 +16,8 @@ def lesson_text(run) -> str:
 
 class Progress:
     """tqdm bar over all control steps of all runs: steps/s, run, lesson, recent return and
-    success, with a line above it per periodic evaluation; then a second bar over the final evaluations' episodes (``evaluations`` of them)."""
+    success, with a line above it per periodic evaluation; then a second bar over the final
+    evaluations' episodes (``evaluations`` of them)."""
 
     def __init__(self, total: int, enabled: bool = True, evaluations: int = 0):
         self.bar = self.eval_bar = None
