@@ -13,6 +13,7 @@ import numpy as np
 
 from agents import checkpoint, trees
 from agents.sac.builder import SACBuilder
+from agents.sac import state_layout
 from agents.sac.config import SACConfig
 
 
@@ -301,7 +302,8 @@ class CurriculumRun:
             raise checkpoint.CheckpointError(f"{path} lacks the run state {missing} (not written by a CurriculumRun)")
         loop = self.loop
         try:
-            loop.learner.set_state(trees.rebuild(state["learner"], loop.learner.state, "the stored learner"))
+            stored = state_layout.upgrade(state["learner"])  # an earlier layout resumes
+            loop.learner.set_state(trees.rebuild(stored, loop.learner.state, "the stored learner"))
         except ValueError as e:
             raise checkpoint.CheckpointError(f"{path}: {e}") from None
         loop.actor.update(loop.learner.policy_params)

@@ -274,7 +274,7 @@ def test_fine_inputs_resolve_small_errors_that_plain_inputs_leave_near_zero():
     assert plain.policy_init(jax.random.PRNGKey(0))["policy_torso/~/linear_0"]["w"].shape == (OBS, 16)
     params = fine.policy_init(jax.random.PRNGKey(0))
     assert params["policy_torso/~/linear_0"]["w"].shape == (2 * OBS, 16)
-    assert fine.q_init(jax.random.PRNGKey(0))["q1/~/linear_0"]["w"].shape == (2 * OBS + ACT, 16)
+    assert fine.q_init(jax.random.PRNGKey(0))["critic/~/linear_0"]["w"].shape == (2, 2 * OBS + ACT, 16)
     first = jax.tree_util.tree_map(np.asarray, params)["policy_torso/~/linear_0"]
     near, off = np.zeros(OBS, np.float32), np.full(OBS, 0.005, np.float32)
     seen = [np.concatenate([x, np.tanh(100.0 * x)]) for x in (near, off)]

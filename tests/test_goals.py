@@ -106,8 +106,8 @@ def test_resumed_her_run_is_bit_exact(tmp_path):
     n = len(a.loop.replay)
     for field in a.loop.replay.fields:
         np.testing.assert_array_equal(getattr(a.loop.replay, field)[:n], getattr(b.loop.replay, field)[:n])
-    for x, y in zip(*(np.asarray(v) for v in (a.loop.learner.get_state().q_params["q1_head"]["w"],
-                                              b.loop.learner.get_state().q_params["q1_head"]["w"]))):
+    for x, y in zip(*(np.asarray(v) for v in (a.loop.learner.get_state().q_params["critic_head"]["w"],
+                                              b.loop.learner.get_state().q_params["critic_head"]["w"]))):
         np.testing.assert_array_equal(x, y)
 
 

@@ -6,8 +6,11 @@ import numpy as np
 import pytest
 from dm_control import suite
 
+import robostrich_suite
 from robostrich_suite import gym_adapter, targets
-from robostrich_suite.tasks.measurement import measure
+from agents.robostrich.evaluate import episodes
+from robostrich_suite import load_policy
+from robostrich_suite.tasks.measurement import errors, measure
 
 
 def test_a_reaching_tasks_measurement_is_its_rewards_success_and_gyms_info():
@@ -27,6 +30,7 @@ def test_a_reaching_tasks_measurement_is_its_rewards_success_and_gyms_info():
         assert measured.is_success == (reward == 0.0) == task.is_success(physics)
         assert measured.position_error == task.position_error(physics)
         assert measured.attitude_error == task.attitude_error(physics)
+        assert errors(env.dm_env) == (measured.position_error, measured.attitude_error)
         assert set(info) == set(measured.as_dict())
         for key, value in measured.as_dict().items():
             np.testing.assert_array_equal(info[key], value, err_msg=key)
@@ -43,7 +47,23 @@ def test_point_mass_is_measured_by_its_distance_and_other_domains_by_nothing():
     measured = measure(env)
     assert measured.position_error == env.physics.mass_to_target_dist() and measured.attitude_error == 0.0
     assert measured.is_success == (measured.position_error <= 0.05) and measured.target is None
+    assert errors(env) == (measured.position_error, 0.0)
     env = suite.load("cartpole", "balance", task_kwargs={"random": 0})
     env.reset()
     measured = measure(env)
     assert math.isnan(measured.position_error) and not measured.is_success and measured.head_position is None
+
+
+@pytest.mark.parametrize("domain", ["robostrich", "robostrich_a1"])
+def test_an_evaluation_that_keeps_only_the_errors_summarises_its_episode_as_the_full_reading(domain):
+    """The shipped policy's episode towards a stored pose, read in full and by its errors alone."""
+    policy = load_policy(domain)
+    env = robostrich_suite.load(domain, "lesson2", task_kwargs={"random": 3})  # the same target for both
+    full = episodes.rollout(env, policy, policy.flatten)
+    lean = episodes.rollout(robostrich_suite.load(domain, "lesson2", task_kwargs={"random": 3}), policy,
+                            policy.flatten, errors_only=True)
+    assert lean["position_error"] == full["position_error"] and lean["reward"] == full["reward"]
+    assert episodes._episode_summary(lean) == episodes._episode_summary(full)
+    assert len(full["position_error"]) == 250 and min(full["position_error"]) < 0.05
+    with pytest.raises(ValueError, match="on_step"):
+        episodes.rollout(env, policy, policy.flatten, on_step=print, errors_only=True)

@@ -115,21 +115,25 @@ def test_new_inputs_get_zero_rows_in_every_first_layer_and_its_moments(source, t
     assert len(rows) == 8
     state = transferred.loop.learner.state
     source_state = source[0].loop.learner.state
+    moments = {group: transfer._unravel(getattr(state, f"{group}_opt_state")[0].mu, params)
+               for group, params in (("policy", state.policy_params), ("q", state.q_params))}
     trees = {"policy": state.policy_params, "q": state.q_params, "target_q": state.target_q_params,
-             "policy mu": state.policy_opt_state[0].mu, "policy nu": state.policy_opt_state[0].nu,
-             "q mu": state.q_opt_state[0].mu, "q nu": state.q_opt_state[0].nu}
+             "policy mu": moments["policy"], "q mu": moments["q"],
+             "policy nu": transfer._unravel(state.policy_opt_state[0].nu, state.policy_params),
+             "q nu": transfer._unravel(state.q_opt_state[0].nu, state.q_params)}
     for name, tree in trees.items():
         first = [m for m in tree if m.endswith("linear_0")]
-        assert len(first) == (1 if name.startswith("policy") else 2), (name, list(tree))
-        for module in first:
-            w = np.asarray(tree[module]["w"])
-            assert w.shape[0] == transferred.loop.flattener.size + (0 if name.startswith("policy") else 9)
-            assert not np.any(w[rows]), (name, module)
-            mapped = np.delete(w, rows, axis=0)
-            assert np.count_nonzero(mapped) > 0.9 * mapped.size, (name, module)
-    # A moment's row is the source's row (head_position's forward component is the frame's x).
-    source_mu = np.asarray(source_state.q_opt_state[0].mu["q1_linear_0"]["w"])
-    np.testing.assert_array_equal(np.asarray(state.q_opt_state[0].mu["q1_linear_0"]["w"])[0], source_mu[0])
+        assert len(first) == 1, (name, list(tree))
+        twins = 1 if name.startswith("policy") else 2  # the twin critics stacked
+        w = np.asarray(tree[first[0]]["w"]).reshape(twins, *np.shape(tree[first[0]]["w"])[-2:])
+        assert w.shape[1] == transferred.loop.flattener.size + (0 if name.startswith("policy") else 9)
+        assert not np.any(w[:, rows]), name
+        mapped = np.delete(w, rows, axis=1)
+        assert np.count_nonzero(mapped) > 0.9 * mapped.size, name
+    # A moment's row is the source's row (head_position's forward component is the frame's x), in
+    # each of the twin critics.
+    source_mu = transfer._unravel(source_state.q_opt_state[0].mu, source_state.q_params)["critic_linear_0"]["w"]
+    np.testing.assert_array_equal(np.asarray(moments["q"]["critic_linear_0"]["w"])[:, 0], np.asarray(source_mu)[:, 0])
 
 
 def test_observation_map_follows_the_real_layouts():

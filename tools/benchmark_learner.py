@@ -80,10 +80,10 @@ def plain_sac(networks, config):
         return update
 
     def initial(key):
-        st = init_state(networks, config, key)
+        st = init_state(networks, config, key)  # the networks' parameters; its own optimisers' states
         return {"pi": st.policy_params, "q": st.q_params, "target_q": st.target_q_params,
-                "pi_opt": st.policy_opt_state, "q_opt": st.q_opt_state, "log_alpha": st.log_alpha,
-                "a_opt": st.alpha_opt_state}
+                "pi_opt": pi_opt.init(st.policy_params), "q_opt": q_opt.init(st.q_params), "log_alpha": st.log_alpha,
+                "a_opt": a_opt.init(st.log_alpha)}
     return make, initial
 
 

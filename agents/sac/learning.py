@@ -32,8 +32,10 @@ class TrainingState(NamedTuple):
 
 
 def make_optimizers(config: SACConfig):
-    """One Adam per parameter group, as in Algorithm 1 (lambda_Q, lambda_pi, lambda_alpha)."""
-    return (optax.adam(config.learning_rate), optax.adam(config.learning_rate),
+    """One Adam per parameter group, as in Algorithm 1 (lambda_Q, lambda_pi, lambda_alpha); the
+    networks' on one vector each (``optax.flatten``): one update of a few large arrays instead of
+    many small ones."""
+    return (optax.flatten(optax.adam(config.learning_rate)), optax.flatten(optax.adam(config.learning_rate)),
             optax.adam(config.learning_rate))
 
 
@@ -150,7 +152,9 @@ def _jitted_update_many(networks: SACNetworks, config: SACConfig):
         state, metrics = jax.lax.scan(update, state, batches)
         return state, jax.tree_util.tree_map(jnp.mean, metrics)
 
-    return jax.jit(update_many)
+    # The state's buffers are given to the update (donated): it writes the new state where the old
+    # one was. An array a caller still views from numpy (an actor's parameters) is copied instead.
+    return jax.jit(update_many, donate_argnums=0)
 
 
 class SACLearner:

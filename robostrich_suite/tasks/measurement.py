@@ -74,3 +74,13 @@ def measure(env) -> Measurement:
     if hasattr(physics, "mass_to_target_dist"):  # dm_control's point_mass
         return without_head(float(physics.mass_to_target_dist()), 0.0)
     return without_head(math.nan, math.nan)
+
+
+def errors(env) -> tuple:
+    """(position_error, attitude_error) of :func:`measure`, read without the rest of the reading:
+    for evaluation loops that keep only the errors of each step."""
+    task = env.task
+    if hasattr(task, "measure") and hasattr(task, "position_error"):
+        return task.position_error(env.physics), task.attitude_error(env.physics)
+    measured = measure(env)
+    return measured.position_error, measured.attitude_error

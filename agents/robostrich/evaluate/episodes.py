@@ -8,19 +8,23 @@ import numpy as np
 
 from agents.robostrich.domains import as_domain
 from robostrich_suite import cli as cli_lib
+from robostrich_suite.tasks import measurement
 from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, PRECISE_POSITION_TOLERANCE
 from robostrich_suite.tasks.measurement import measure
 
 
-def rollout(env, actor, flattener, on_step=None, action_repeat: int = 1) -> dict:
+def rollout(env, actor, flattener, on_step=None, action_repeat: int = 1, errors_only: bool = False) -> dict:
     """One episode with `actor` (acting every `action_repeat` control steps); per-control-step series
     of the task's measurement (robostrich_suite/tasks/measurement.py), read once per step.
     ``on_step(env, action, timestep, measured)``, if given, sees every step as it happens (a
-    recording's ``log_step``; action None at the reset)."""
+    recording's ``log_step``; action None at the reset). ``errors_only``: only the series an
+    episode's summary reads (the errors and the rewards), for evaluations that keep no series."""
+    if errors_only and on_step is not None:
+        raise ValueError("a rollout that keeps only the errors has no measurement to show on_step")
     timestep = env.reset()
     physics = env.physics
     measured = measure(env)
-    has_head = measured.head_position is not None
+    has_head = measured.head_position is not None and not errors_only
     series = {k: [] for k in ("time", "position_error", "attitude_error", "head_position", "head_attitude",
                               "target", "action", "reward")}
     # the task's own tolerances, not the paper's constants
@@ -34,11 +38,16 @@ def rollout(env, actor, flattener, on_step=None, action_repeat: int = 1) -> dict
             action = actor.select_action(flattener(timestep.observation))
         timestep = env.step(action)
         step += 1
+        series["reward"].append(float(timestep.reward))
+        if errors_only:
+            position_error, attitude_error = measurement.errors(env)
+            series["position_error"].append(position_error)
+            series["attitude_error"].append(abs(attitude_error))
+            continue
         measured = measure(env)
         series["time"].append(float(physics.data.time))
         series["position_error"].append(measured.position_error)
         series["attitude_error"].append(abs(measured.attitude_error))
-        series["reward"].append(float(timestep.reward))
         series["action"].append(np.asarray(action, np.float64).tolist())
         if has_head:
             series["head_position"].append(measured.head_position.tolist())
@@ -117,7 +126,7 @@ def evaluate_heldout(actor, flattener, domain, task: str, num_targets: Optional[
             env.task.set_target_pool(targets[i])  # reuse the compiled model (building one takes ~0.3 s)
         else:
             env = domain.make_environment(task, seed, target_pool=targets[i:i + 1])
-        row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat))
+        row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat, errors_only=True))
         if targets is not None:
             row["target"] = targets[i].tolist()
         episodes.append(row)
@@ -152,7 +161,7 @@ def evaluate_heldout_moving(actor, flattener, domain="robostrich", num_targets: 
                 env.task.forget_last_state()
             env.task.continue_next_from(rest)
             env.task.set_target_pool(target)
-            row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat))
+            row = _episode_summary(rollout(env, actor, flattener, action_repeat=action_repeat, errors_only=True))
             row.update(target=np.asarray(target).tolist(), start=k, start_target=np.asarray(start).tolist(),
                        start_position_error=held.position_error, start_attitude_error=abs(held.attitude_error))
             episodes.append(row)

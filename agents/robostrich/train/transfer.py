@@ -25,11 +25,13 @@ import dataclasses
 import os
 from typing import Dict, Mapping, Optional, Sequence, Tuple
 
+import jax
 import numpy as np
 
 from agents import checkpoint, trees
 from agents.robostrich.domain_run import named_layout, parse_plan
 from agents.robostrich.train.main_job import MAIN_JOB_SAC
+from agents.sac import state_layout
 from agents.sac.config import SACConfig
 from robostrich_suite.tasks import quadruped_tasks as qt
 
@@ -120,41 +122,55 @@ class ObservationMap:
 
 # -- parameters and optimiser states ---------------------------------------------------------------
 def _is_first_layer(module: str) -> bool:
-    """haiku's MLP 'policy_torso/~/linear_0', 'q1/~/linear_0'; the layer-normed critic's 'q1_linear_0'."""
+    """haiku's MLP 'policy_torso/~/linear_0', 'critic/~/linear_0'; the layer-normed critic's 'critic_linear_0'."""
     return module.endswith("linear_0")
 
 
 def map_params(params: Mapping, obs_map: ObservationMap, moments: bool = False) -> Dict:
     """The parameters (or, ``moments``, an optimiser's per-parameter moments) for the target inputs.
 
-    First layers' weights: rows of mapped inputs copied, new inputs' rows zero, rows past the
-    observation (a critic's action) copied; biases absorb the offsets (not for moments)."""
+    First layers' weights (the twin critics' stacked on a leading axis): rows of mapped inputs
+    copied, new inputs' rows zero, rows past the observation (a critic's action) copied; biases
+    absorb the offsets (not for moments)."""
     out = {}
     for module, leaves in params.items():
         leaves = dict(leaves)
         if _is_first_layer(module):
             w = np.asarray(leaves["w"])
-            extra = w.shape[0] - obs_map.source_size  # the critic's action inputs
+            extra = w.shape[-2] - obs_map.source_size  # the critic's action inputs
             if extra < 0:
-                raise TransferError(f"layer {module!r} reads {w.shape[0]} inputs, fewer than the checkpoint's "
+                raise TransferError(f"layer {module!r} reads {w.shape[-2]} inputs, fewer than the checkpoint's "
                                     f"{obs_map.source_size} observations")
             mapped = obs_map.index >= 0
-            new_w = np.zeros((obs_map.target_size + extra, w.shape[1]), w.dtype)
-            new_w[:obs_map.target_size][mapped] = w[obs_map.index[mapped]]
-            new_w[obs_map.target_size:] = w[obs_map.source_size:]
+            new_w = np.zeros(w.shape[:-2] + (obs_map.target_size + extra, w.shape[-1]), w.dtype)
+            new_w[..., np.flatnonzero(mapped), :] = w[..., obs_map.index[mapped], :]
+            new_w[..., obs_map.target_size:, :] = w[..., obs_map.source_size:, :]
             if not moments:
                 b = np.asarray(leaves["b"], np.float64)
-                shift = obs_map.offset @ new_w[:obs_map.target_size].astype(np.float64)
+                shift = np.einsum("i,...io->...o", obs_map.offset, new_w[..., :obs_map.target_size, :].astype(np.float64))
                 leaves["b"] = (b - shift).astype(np.asarray(leaves["b"]).dtype)
             leaves["w"] = new_w
         out[module] = leaves
     return out
 
 
+def _unravel(flat, params: Mapping) -> Dict:
+    """A vector of ``optax.flatten``'s moments as a tree shaped like ``params``."""
+    leaves, structure = jax.tree_util.tree_flatten(params)
+    ends = np.cumsum([np.size(leaf) for leaf in leaves])
+    parts = np.split(np.asarray(flat), ends[:-1])
+    return jax.tree_util.tree_unflatten(structure, [p.reshape(np.shape(leaf)) for p, leaf in zip(parts, leaves)])
+
+
+def _ravel(tree) -> np.ndarray:
+    return np.concatenate([np.ravel(leaf) for leaf in jax.tree_util.tree_leaves(tree)])
+
+
 def map_opt_state(opt_state, params: Mapping, obs_map: ObservationMap):
-    """An optax state with every per-parameter tree (Adam's mu and nu) mapped as moments."""
-    if isinstance(opt_state, Mapping) and set(opt_state) == set(params):
-        return map_params(opt_state, obs_map, moments=True)
+    """An optax state with Adam's moments (one vector per parameter group) mapped as the parameters are."""
+    size = sum(np.size(leaf) for leaf in jax.tree_util.tree_leaves(params))
+    if isinstance(opt_state, np.ndarray) and opt_state.ndim == 1 and opt_state.size == size > 1:
+        return _ravel(map_params(_unravel(opt_state, params), obs_map, moments=True))
     if isinstance(opt_state, tuple):
         children = [map_opt_state(child, params, obs_map) for child in opt_state]
         return type(opt_state)(*children) if hasattr(opt_state, "_fields") else tuple(children)
@@ -168,7 +184,7 @@ def stored_learner(arrays, fresh, path: str):
     averaged = isinstance(arrays, dict) and any(p.startswith(".average_policy_params") for p in arrays)
     like = fresh._replace(average_policy_params=fresh.policy_params if averaged else None)
     try:
-        return trees.rebuild(arrays, like, f"the learner of {path}")
+        return trees.rebuild(state_layout.upgrade(arrays), like, f"the learner of {path}")
     except ValueError as error:
         raise TransferError(f"--init-from: {error}") from None
 
