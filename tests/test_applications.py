@@ -7,7 +7,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from agents.robostrich.applications import commands as application_commands
+from agents.robostrich.applications import stabilize
 from agents.robostrich.applications import figures as application_figures
 from agents.robostrich.applications import rollouts as applications
 from agents.robostrich.applications import narrow_gap as gap
@@ -88,7 +88,7 @@ def test_a_checkpoint_is_evaluated_beside_the_references(tmp_path):
     config = SACConfig(batch_size=16, hidden_sizes=(16, 16), min_replay_size=50, max_replay_size=1000)
     run = DomainRun(parse_plan("robostrich_a1/lesson1:100"), config, seed=0, run_dir=str(tmp_path / "run"))
     run.save_checkpoint()
-    result = application_commands.stabilize_main(
+    result = stabilize.main(
         [run.checkpoint_path, "--reference", run.checkpoint_path, "--seeds", "1", "--time-limit", "1.5",
          "--out", str(tmp_path / "out"), "--no-rerun", "--no-figures", "--no-progress"])
     assert list(result["policies"]) == ["trained", "reference", "zero", "lookup"]

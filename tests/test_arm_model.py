@@ -7,7 +7,7 @@ import pytest
 from dm_control import mjcf
 
 from robostrich_suite import physics as physics_lib
-from robostrich_suite import xml_export
+from robostrich_suite import export_xml
 from robostrich_suite import scenes
 from robostrich_suite.model import arm, table1
 from robostrich_suite.robostrich import Physics, get_model_and_assets
@@ -124,7 +124,7 @@ def test_ventral_tendons_flex_forward_and_dorsal_tendon_extends_back(physics):
 
 
 def test_checked_in_xml_is_up_to_date(repo_xml_dir):
-    for name, generate in xml_export.generators().items():
+    for name, generate in export_xml.generators().items():
         path = repo_xml_dir / name
         assert path.exists(), f"xml/{name} is missing: run robostrich-export-xml --out xml"
         assert path.read_text() == generate(), (

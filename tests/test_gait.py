@@ -4,7 +4,7 @@ import pytest
 
 from robostrich_suite.model import legs
 from robostrich_suite.model import quadruped as quad
-from robostrich_suite.studies import gait_generation
+from robostrich_suite.studies import gait as gait_command
 from robostrich_suite.tasks import gait
 
 
@@ -59,7 +59,7 @@ def test_trot_targets_follow_the_trunk_height_command():
 
 
 def test_gait_file_round_trips(tmp_path):
-    times, targets = gait_generation.sample_trot(gait.TrotGait(frequency=2.0), rate=50)
+    times, targets = gait_command.sample_trot(gait.TrotGait(frequency=2.0), rate=50)
     path = tmp_path / "trot.csv"
     gait.write_gait_file(path, times, targets, comment="test\nsecond comment line")
     times2, targets2 = gait.read_gait_file(path)
@@ -158,7 +158,7 @@ def test_wrong_header_is_named(tmp_path):
 
 def test_gait_main_writes_a_loadable_file(tmp_path):
     path = tmp_path / "trot.csv"
-    gait_generation.main(["--out", str(path), "--frequency", "3", "--stride", "0.08"])
+    gait_command.main(["--out", str(path), "--frequency", "3", "--stride", "0.08"])
     replay = gait.GaitReplay.from_file(path)
     assert replay.period == pytest.approx(1 / 3)
 
@@ -210,7 +210,7 @@ def test_gait_option_takes_a_path_or_a_gait_object_and_names_anything_else(tmp_p
     """What README says `gait=` accepts; a standing task refuses a gait instead of ignoring it."""
     import robostrich_suite
     path = tmp_path / "trot.csv"
-    gait.write_gait_file(path, *gait_generation.sample_trot())
+    gait.write_gait_file(path, *gait_command.sample_trot())
     for accepted in (str(path), path, gait.TrotGait(), gait.GaitReplay.from_file(path)):
         env = robostrich_suite.load("robostrich_a1", "lesson4", task_kwargs=dict(gait=accepted, time_limit=0.016))
         env.reset()

@@ -15,7 +15,7 @@ TOP_LEVEL = {"cli": "utilities", "rerun_log": "utilities", "rerun_blueprint": "u
              "parallel": "utilities", "progress": "utilities", "parsing": "utilities", "targets": "model", "physics": "physics", "quadruped_physics": "physics",
              "scenes": "physics", "fingerprint": "physics", "robostrich": "domains",
              "robostrich_a1": "domains", "gym_adapter": "domains", "policies": "domains",
-             "xml_export": "domains", "speed_benchmarks": "domains", "__init__": "domains"}
+             "export_xml": "domains", "speed_benchmarks": "domains", "__init__": "domains"}
 
 
 def layer_of(module: str) -> str:
@@ -85,10 +85,13 @@ def test_the_command_launcher_belongs_to_neither_package_and_imports_only_the_st
     assert set(imported(launcher)) == {"importlib", "os", "signal", "sys"}
     table = next(node.value for node in ast.parse(launcher.read_text()).body
                  if isinstance(node, ast.Assign) and [t.id for t in node.targets] == ["COMMANDS"])
-    for target in ast.literal_eval(table).values():
+    for prog, target in ast.literal_eval(table).items():
         module = target.split(":")[0].split(".")
         assert module[0] in ("robostrich_suite", "agents"), target
         assert ROOT.joinpath(*module).with_suffix(".py").exists(), target
+        # named after the command: robostrich-export-xml in .../export_xml.py or .../export_xml/command.py
+        word = prog.removeprefix("robostrich-").replace("-", "_")
+        assert module[-1] == word or module[-2:] == [word, "command"], (prog, target)
 
 
 @pytest.mark.parametrize("module", ["robostrich_suite.model.arm", "robostrich_suite.physics"])

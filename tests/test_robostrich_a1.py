@@ -6,7 +6,7 @@ from absl.testing import absltest
 from dm_env import test_utils
 
 import robostrich_suite
-from robostrich_suite import robostrich_a1 as a1, xml_export
+from robostrich_suite import robostrich_a1 as a1
 from robostrich_suite import scenes
 from robostrich_suite.model import arm, quadruped as quad
 from robostrich_suite.studies import walk

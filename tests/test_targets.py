@@ -81,13 +81,13 @@ def test_another_arm_gets_a_warning_and_its_own_targets(tmp_path):
 
 
 def test_running_the_module_prints_no_runpy_warning():
-    """`python -m robostrich_suite.studies.target_generation` without runpy's RuntimeWarning about
-    sys.modules: importing the package must not import the generation module."""
+    """`python -m robostrich_suite.studies.targets` without runpy's RuntimeWarning about
+    sys.modules: importing the package must not import the command module."""
     import os
     import subprocess
     import sys
     env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
-    result = subprocess.run([sys.executable, "-W", "default", "-m", "robostrich_suite.studies.target_generation",
+    result = subprocess.run([sys.executable, "-W", "default", "-m", "robostrich_suite.studies.targets",
                              "--help"],
                             capture_output=True, text=True, env=env, timeout=120)
     assert result.returncode == 0, result.stderr

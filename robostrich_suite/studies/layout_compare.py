@@ -15,7 +15,7 @@ Every case is one routing on the same Table 1 links.  Per case:
 * **rolling / lever**: the movement tests' attitude ranges at equal head travel and
   their ratio (:mod:`robostrich_suite.studies.movement`; the layout's ventral tendons ramped
   caudal to cranial, its most cranial dorsal tendon's input held);
-* **lookup** (the installed command, from the agent's side: ``agents/robostrich/layout_comparison.py``):
+* **lookup** (the installed command, from the agent's side: ``agents/robostrich/layouts.py``):
   held-out success of the no-learning baseline (nearest stored level pose, hold its inputs) on
   the case's own targets; with ``--train``, the held-out success of a short curriculum run of
   ``robostrich-train``'s learner too.
@@ -278,7 +278,7 @@ def _plain(docstring: str) -> str:
 
 
 def build_parser() -> cli_lib.Parser:
-    """The command's options; the agent's side (agents/robostrich/layout_comparison.py) adds its own."""
+    """The command's options; the agent's side (agents/robostrich/layouts.py) adds its own."""
     parser = cli_lib.Parser(
         prog=PROG,
         description="Compare tendon layouts (and passive joint stiffnesses) of the Robostrich "
@@ -378,7 +378,7 @@ def report(args, cases, region, results, command: str) -> pathlib.Path:
 
 def cli(argv=None) -> int:
     """The comparison without the agent's measures: exit status 0, or 2 with a one-line error
-    (robostrich_suite.cli); the installed ``robostrich-layouts`` is agents/robostrich/layout_comparison.py's."""
+    (robostrich_suite.cli); the installed ``robostrich-layouts`` is agents/robostrich/layouts.py's."""
     return cli_lib.run(main, PROG, argv)
 
 

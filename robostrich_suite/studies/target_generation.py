@@ -12,6 +12,8 @@ The shipped files are random draws plus a sought pose per blue-region sample (do
 names each file's command)::
 
     robostrich-targets --samples 2000 --blue-samples 600000 --layout ventral_slips --out robostrich_suite/data/level_head_poses.npz
+
+(the command: robostrich_suite/studies/targets.py)
 """
 from __future__ import annotations
 
@@ -20,14 +22,12 @@ import pathlib
 import numpy as np
 
 from robostrich_suite import atomic_files
-from robostrich_suite import cli as cli_lib
-from robostrich_suite import outputs, parallel
+from robostrich_suite import parallel
 from robostrich_suite import progress as progress_lib
 from robostrich_suite import targets
 from robostrich_suite import fingerprint as fingerprint_lib
 from robostrich_suite.studies import pose_seek, workspace
 from robostrich_suite import scenes
-from robostrich_suite.model import layouts
 from robostrich_suite.studies import coverage
 
 SEEK_LEVEL_TIME = 2.5  # s of dorsal-input tuning per draw before it is held
@@ -141,51 +141,3 @@ def save_level_poses(path: pathlib.Path, poses: dict, fingerprint: str, allow_em
                             **{key: np.asarray(poses[key]) for key in ("head_position", "head_attitude", "control")})
     targets.clear_cache()
     return len(poses["head_position"])
-
-
-def main(argv=None) -> None:
-    parser = cli_lib.Parser(prog="robostrich-targets", description=__doc__.split("\n")[0])
-    parser.add_argument("--samples", type=cli_lib.whole_number(0), default=4000,
-                        help="random held inputs (default: %(default)s)")
-    parser.add_argument("--blue-samples", type=cli_lib.whole_number(0), default=0,
-                        help="kinematic samples whose level heads (the blue region) each get a sought "
-                             "pose (default: %(default)s)")
-    parser.add_argument("--seed", type=cli_lib.seed, default=0,
-                        help="random seed of the held inputs and samples (default: %(default)s)")
-    parser.add_argument("--out", type=pathlib.Path, required=True,
-                        help="target file to write (the shipped one: robostrich_suite/data/level_head_poses.npz)")
-    parser.add_argument("--seek-level-time", type=cli_lib.seconds(allow_zero=True), default=SEEK_LEVEL_TIME,
-                        help="seconds of dorsal tuning towards a level head per draw (0: off; default: %(default)s)")
-    parser.add_argument("--append", action="store_true",
-                        help="add to the poses already in --out (use a new --seed)")
-    parser.add_argument("--recheck", action="store_true",
-                        help="draw nothing: re-hold the stored inputs of --out on today's arm and keep "
-                             "the poses still held level, at their new positions")
-    parser.add_argument("--layout", default=None, metavar="NAME",
-                        help="built-in tendon layout of the arm (default: the tasks' own)")
-    parser.add_argument("--workers", type=cli_lib.whole_number(1, cli_lib.MAX_WORKERS), default=2,
-                        help="processes drawing poses (default: %(default)s)")
-    args = parser.parse_args(argv)
-    outputs.check_file(args.out)
-    layout = None
-    if args.layout is not None:
-        layout = layouts.build(args.layout)
-    if args.recheck:
-        if not args.out.exists():
-            raise FileNotFoundError(f"--recheck: no target file at {args.out}")
-        kept, stored = recheck(args.out, layout=layout, progress=True)
-        print(f"kept {kept} of {stored} level-head poses in {args.out}")
-        return
-    count = generate(args.samples, args.seed, args.out, workers=args.workers, append=args.append,
-                     seek_level_time=args.seek_level_time, layout=layout, blue_samples=args.blue_samples)
-    print(f"wrote {count} level-head poses to {args.out}")
-
-
-def cli(argv=None) -> int:
-    """Console script `robostrich-targets`: exit status 0, or 2 with a one-line error (robostrich_suite.cli)."""
-    return cli_lib.run(main, "robostrich-targets", argv)
-
-
-if __name__ == "__main__":
-    import sys
-    sys.exit(cli())

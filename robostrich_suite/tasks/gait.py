@@ -30,7 +30,7 @@ file raises ``ValueError`` naming the line and column.
 
 Regenerate the shipped file with
 ``robostrich-gait --out robostrich_suite/data/a1_trot.csv``
-(:mod:`robostrich_suite.studies.gait_generation`).
+(:mod:`robostrich_suite.studies.gait`).
 """
 from __future__ import annotations
 
