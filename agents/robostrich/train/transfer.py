@@ -147,7 +147,8 @@ def map_params(params: Mapping, obs_map: ObservationMap, moments: bool = False) 
             new_w[..., obs_map.target_size:, :] = w[..., obs_map.source_size:, :]
             if not moments:
                 b = np.asarray(leaves["b"], np.float64)
-                shift = np.einsum("i,...io->...o", obs_map.offset, new_w[..., :obs_map.target_size, :].astype(np.float64))
+                rows = new_w[..., :obs_map.target_size, :].astype(np.float64)
+                shift = np.einsum("i,...io->...o", obs_map.offset, rows)  # offset @ W', per critic of a pair
                 leaves["b"] = (b - shift).astype(np.asarray(leaves["b"]).dtype)
             leaves["w"] = new_w
         out[module] = leaves
