@@ -6,6 +6,7 @@ import dataclasses
 import json
 
 import jax
+from jax.flatten_util import ravel_pytree
 import numpy as np
 import pytest
 import robostrich_suite
@@ -115,12 +116,12 @@ def test_new_inputs_get_zero_rows_in_every_first_layer_and_its_moments(source, t
     assert len(rows) == 8
     state = transferred.loop.learner.state
     source_state = source[0].loop.learner.state
-    moments = {group: transfer._unravel(getattr(state, f"{group}_opt_state")[0].mu, params)
+    moments = {group: ravel_pytree(params)[1](getattr(state, f"{group}_opt_state")[0].mu)
                for group, params in (("policy", state.policy_params), ("q", state.q_params))}
     trees = {"policy": state.policy_params, "q": state.q_params, "target_q": state.target_q_params,
              "policy mu": moments["policy"], "q mu": moments["q"],
-             "policy nu": transfer._unravel(state.policy_opt_state[0].nu, state.policy_params),
-             "q nu": transfer._unravel(state.q_opt_state[0].nu, state.q_params)}
+             "policy nu": ravel_pytree(state.policy_params)[1](state.policy_opt_state[0].nu),
+             "q nu": ravel_pytree(state.q_params)[1](state.q_opt_state[0].nu)}
     for name, tree in trees.items():
         first = [m for m in tree if m.endswith("linear_0")]
         assert len(first) == 1, (name, list(tree))
@@ -132,7 +133,7 @@ def test_new_inputs_get_zero_rows_in_every_first_layer_and_its_moments(source, t
         assert np.count_nonzero(mapped) > 0.9 * mapped.size, name
     # A moment's row is the source's row (head_position's forward component is the frame's x), in
     # each of the twin critics.
-    source_mu = transfer._unravel(source_state.q_opt_state[0].mu, source_state.q_params)["critic_linear_0"]["w"]
+    source_mu = ravel_pytree(source_state.q_params)[1](source_state.q_opt_state[0].mu)["critic_linear_0"]["w"]
     np.testing.assert_array_equal(np.asarray(moments["q"]["critic_linear_0"]["w"])[:, 0], np.asarray(source_mu)[:, 0])
 
 

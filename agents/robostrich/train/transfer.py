@@ -27,6 +27,7 @@ from typing import Dict, Mapping, Optional, Sequence, Tuple
 
 import jax
 import numpy as np
+from jax.flatten_util import ravel_pytree
 
 from agents import checkpoint, trees
 from agents.robostrich.domain_run import named_layout, parse_plan
@@ -155,23 +156,12 @@ def map_params(params: Mapping, obs_map: ObservationMap, moments: bool = False) 
     return out
 
 
-def _unravel(flat, params: Mapping) -> Dict:
-    """A vector of ``optax.flatten``'s moments as a tree shaped like ``params``."""
-    leaves, structure = jax.tree_util.tree_flatten(params)
-    ends = np.cumsum([np.size(leaf) for leaf in leaves])
-    parts = np.split(np.asarray(flat), ends[:-1])
-    return jax.tree_util.tree_unflatten(structure, [p.reshape(np.shape(leaf)) for p, leaf in zip(parts, leaves)])
-
-
-def _ravel(tree) -> np.ndarray:
-    return np.concatenate([np.ravel(leaf) for leaf in jax.tree_util.tree_leaves(tree)])
-
-
 def map_opt_state(opt_state, params: Mapping, obs_map: ObservationMap):
     """An optax state with Adam's moments (one vector per parameter group) mapped as the parameters are."""
     size = sum(np.size(leaf) for leaf in jax.tree_util.tree_leaves(params))
     if isinstance(opt_state, np.ndarray) and opt_state.ndim == 1 and opt_state.size == size > 1:
-        return _ravel(map_params(_unravel(opt_state, params), obs_map, moments=True))
+        moments = ravel_pytree(params)[1](opt_state)  # optax.flatten's order: the tree's leaves
+        return np.asarray(ravel_pytree(map_params(moments, obs_map, moments=True))[0])
     if isinstance(opt_state, tuple):
         children = [map_opt_state(child, params, obs_map) for child in opt_state]
         return type(opt_state)(*children) if hasattr(opt_state, "_fields") else tuple(children)
