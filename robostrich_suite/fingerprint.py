@@ -3,6 +3,7 @@ to rest.  Target files carry the fingerprint of the arm they were made with, so 
 set made with another arm is recognised as stale."""
 from __future__ import annotations
 
+import functools
 import hashlib
 import warnings
 
@@ -15,7 +16,16 @@ from robostrich_suite.model import arm as arm_lib
 def model_fingerprint(spec: arm_lib.ArmSpec | None = None,
                       layout: arm_lib.TendonLayout | None = None) -> str:
     """Short hash of what decides where the arm comes to rest; a pose set made with
-    another arm is stale.  Colours, names and sensors do not count."""
+    another arm is stale.  Colours, names and sensors do not count.  Kept per arm: every
+    environment made for an arm other than the default asks for it."""
+    try:
+        return _kept_fingerprint(spec, layout)
+    except TypeError:  # an unhashable spec: computed each time
+        return compiled_fingerprint(scenes.frame_physics(spec, layout).model)
+
+
+@functools.lru_cache(maxsize=16)
+def _kept_fingerprint(spec, layout) -> str:
     return compiled_fingerprint(scenes.frame_physics(spec, layout).model)
 
 

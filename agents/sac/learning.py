@@ -157,6 +157,13 @@ def _jitted_update_many(networks: SACNetworks, config: SACConfig):
     return jax.jit(update_many, donate_argnums=0)
 
 
+@functools.lru_cache(maxsize=None)
+def _jitted_init_state(networks: SACNetworks, config: SACConfig):
+    """init_state as one compiled function: run op by op, the networks' initialisers compile (or read
+    from JAX's cache) about a hundred small programs; the values are the same bit for bit."""
+    return jax.jit(functools.partial(init_state, networks, config))
+
+
 class SACLearner:
     """Holds the training state; `step` runs a stack of updates in one jitted call."""
 
@@ -164,7 +171,7 @@ class SACLearner:
         self.networks = networks
         self.config = config
         self._update_many = _jitted_update_many(networks, config)
-        self.state = init_state(networks, config, key)
+        self.state = _jitted_init_state(networks, config)(key)
 
     def step(self, batches: Transitions) -> dict:
         """batches: arrays with a leading [num_updates, batch_size] shape. Returns mean metrics (floats)."""

@@ -13,6 +13,8 @@ registers the curriculum's lessons 1-3 in the domain's ``SUITE``:
 from __future__ import annotations
 
 import dataclasses
+import functools
+import types
 from typing import Callable
 
 from dm_control.rl import control
@@ -55,6 +57,23 @@ def check_arm(arm_spec, tendon_layout) -> None:
                         f"got {options.shown(tendon_layout)}")
 
 
+def model_and_assets(get_model_and_assets: Callable, arm_spec, tendon_layout, **model_kwargs):
+    """``get_model_and_assets(arm_spec, tendon_layout, **model_kwargs)``, kept for the last few arms:
+    generating the MJCF takes a tenth of a second, which a run that makes an environment per
+    evaluation would pay again and again for the same arm (an unhashable argument is not kept)."""
+    try:
+        return _kept_model_and_assets(get_model_and_assets, arm_spec, tendon_layout,
+                                      tuple(sorted(model_kwargs.items())))
+    except TypeError:  # unhashable: generated each time
+        return get_model_and_assets(arm_spec, tendon_layout, **model_kwargs)
+
+
+@functools.lru_cache(maxsize=16)
+def _kept_model_and_assets(get_model_and_assets, arm_spec, tendon_layout, model_items):
+    xml, assets = get_model_and_assets(arm_spec, tendon_layout, **dict(model_items))
+    return xml, types.MappingProxyType(dict(assets))
+
+
 @dataclasses.dataclass(frozen=True)
 class LessonFactory:
     """Environments of one domain: ``physics`` (a ``Physics`` class) on the model of
@@ -71,7 +90,7 @@ class LessonFactory:
         environment_kwargs = options.environment_kwargs(environment_kwargs)
         check_arm(arm_spec, tendon_layout)
         physics = self.physics.from_xml_string(
-            *self.get_model_and_assets(arm_spec, tendon_layout, **model_kwargs))
+            *model_and_assets(self.get_model_and_assets, arm_spec, tendon_layout, **model_kwargs))
         environment_kwargs.setdefault("control_timestep", CONTROL_TIMESTEP)
         return control.Environment(physics, task, time_limit=time_limit, **environment_kwargs)
 
