@@ -7,7 +7,8 @@ import pytest
 
 from agents import checkpoint
 from agents.curriculum import LessonSettings
-from agents.robostrich.domain_run import DomainRun, current_fingerprint, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, migrate, parse_plan
 from agents.robostrich.evaluate import evaluation
 from agents.robostrich.train import command, main_job
 from agents.sac.config import SACConfig
@@ -60,7 +61,7 @@ def _rewritten(path, tmp_path, name, **config):
 def trained(tmp_path_factory):
     tiny = dataclasses.replace(main_job.MAIN_JOB_SAC, hidden_sizes=(16, 16), batch_size=16)  # 80 steps: no update
     plan = parse_plan("robostrich/lesson1:40,robostrich/lesson2:40")
-    run = DomainRun(plan, tiny, 0, str(tmp_path_factory.mktemp("run")), checkpoint_every=10 ** 6)
+    run = DomainRun(RunSpec(plan, tiny, 0), str(tmp_path_factory.mktemp("run")), checkpoint_every=10 ** 6)
     run.run()
     run.save_checkpoint()
     return plan, tiny, run
@@ -73,12 +74,12 @@ def test_checkpoints_written_before_a_field_was_added_resume_and_evaluate(traine
     older = str(tmp_path / "older.ckpt")
     config = {k: v for k, v in record["config"].items() if k not in SACConfig.ADDED_FIELDS}
     checkpoint.save(older, checkpoint.load(run.checkpoint_path, None), {**record, "config": config})
-    fresh = DomainRun(plan, tiny, 0, str(tmp_path / "a"))
+    fresh = DomainRun(RunSpec(plan, tiny, 0), str(tmp_path / "a"))
     fresh.restore(older)
     assert fresh.loop.env_steps == 80 and evaluation.load_run_from_checkpoint(older).loop.env_steps == 80
     for changed in ({"fine_input_gain": 30.0}, {"fine_inputs": ("to_target=30",)}):
         with pytest.raises(checkpoint.CheckpointError):
-            DomainRun(plan, dataclasses.replace(tiny, **changed), 0, str(tmp_path / "b")).restore(older)
+            DomainRun(RunSpec(plan, dataclasses.replace(tiny, **changed), 0), str(tmp_path / "b")).restore(older)
 
 
 def test_checkpoints_holding_her_level_goals_resume_and_evaluate(trained, tmp_path):
@@ -86,15 +87,15 @@ def test_checkpoints_holding_her_level_goals_resume_and_evaluate(trained, tmp_pa
     that set the option resumes from it and one without the option is refused."""
     plan, tiny, run = trained
     off = _rewritten(run.checkpoint_path, tmp_path, "off.ckpt", her_level_goals=False)
-    fresh = DomainRun(plan, tiny, 0, str(tmp_path / "a"))
+    fresh = DomainRun(RunSpec(plan, tiny, 0), str(tmp_path / "a"))
     fresh.restore(off)
     assert fresh.loop.env_steps == 80
     assert evaluation.load_run_from_checkpoint(off).loop.env_steps == 80
     on = _rewritten(run.checkpoint_path, tmp_path, "on.ckpt", her_level_goals=True)
-    assert current_fingerprint(checkpoint.read_fingerprint(on))["task_kwargs"] == {"hindsight_level_goals": True}
+    assert migrate(checkpoint.read_fingerprint(on))["task_kwargs"] == {"hindsight_level_goals": True}
     with pytest.raises(checkpoint.CheckpointError, match="hindsight_level_goals"):
-        DomainRun(plan, tiny, 0, str(tmp_path / "b")).restore(on)
-    level = DomainRun(plan, tiny, 0, str(tmp_path / "c"), task_kwargs={"hindsight_level_goals": True})
+        DomainRun(RunSpec(plan, tiny, 0), str(tmp_path / "b")).restore(on)
+    level = DomainRun(RunSpec(plan, tiny, 0, task_kwargs={"hindsight_level_goals": True}), str(tmp_path / "c"))
     level.restore(on)
     assert level.loop.env.task.hindsight_level_goals and evaluation.load_run_from_checkpoint(on).loop.env_steps == 80
     with pytest.raises(ValueError, match="her_level_goals"):

@@ -83,10 +83,11 @@ def test_narrow_gap_reports_every_sub_target_with_contact_forces_from_a_real_rol
 
 
 def test_a_checkpoint_is_evaluated_beside_the_references(tmp_path):
-    from agents.robostrich.domain_run import DomainRun, parse_plan
+    from agents.robostrich.domain_run import DomainRun
+    from agents.robostrich.run_spec import RunSpec, parse_plan
     from agents.sac.config import SACConfig
     config = SACConfig(batch_size=16, hidden_sizes=(16, 16), min_replay_size=50, max_replay_size=1000)
-    run = DomainRun(parse_plan("robostrich_a1/lesson1:100"), config, seed=0, run_dir=str(tmp_path / "run"))
+    run = DomainRun(RunSpec(parse_plan("robostrich_a1/lesson1:100"), config, 0), str(tmp_path / "run"))
     run.save_checkpoint()
     result = stabilize.main(
         [run.checkpoint_path, "--reference", run.checkpoint_path, "--seeds", "1", "--time-limit", "1.5",

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from agents import checkpoint
-from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, parse_plan
 from agents.robostrich.domains import Domain
 from agents.robostrich.train.main_job import MAIN_JOB_SAC
 from robostrich_suite import targets
@@ -87,7 +88,7 @@ def test_a_domain_that_observes_its_sent_actions_gives_every_environment_that_ob
 
 def test_curriculum_runs_every_lesson_on_the_quadruped_and_carries_the_learner(tmp_path):
     plan = parse_plan("lesson1:60,lesson2:60,lesson3:60,lesson4:60", default_domain="robostrich_a1")
-    run = DomainRun(plan, TINY, 0, str(tmp_path / "a1"), checkpoint_every=10 ** 6)
+    run = DomainRun(RunSpec(plan, TINY, 0), str(tmp_path / "a1"), checkpoint_every=10 ** 6)
     learner = run.loop.learner
     run.run()
     assert run.done and run.loop.env_steps == 240
@@ -100,14 +101,14 @@ def test_curriculum_runs_every_lesson_on_the_quadruped_and_carries_the_learner(t
 @pytest.mark.long
 def test_a_layout_is_part_of_the_checkpoint(tmp_path):
     plan = parse_plan("lesson1:40")
-    run = DomainRun(plan, TINY, 0, str(tmp_path / "run"), layout=LAYOUT)
+    run = DomainRun(RunSpec(plan, TINY, 0, layout=LAYOUT), str(tmp_path / "run"))
     assert run.fingerprint()["layout"] == LAYOUT
     run.run()
-    other = DomainRun(plan, TINY, 0, str(tmp_path / "other"))  # the paper's layout
+    other = DomainRun(RunSpec(plan, TINY, 0), str(tmp_path / "other"))  # the paper's layout
     with pytest.raises(checkpoint.CheckpointError, match="layout"):
         other.restore(run.checkpoint_path)
     with pytest.raises(ValueError, match="arm domains"):
-        DomainRun(parse_plan("reacher/easy:10"), TINY, 0, str(tmp_path / "r"), layout=LAYOUT)
+        DomainRun(RunSpec(parse_plan("reacher/easy:10"), TINY, 0, layout=LAYOUT), str(tmp_path / "r"))
 
 
 def test_periodic_evaluation_targets_spread_over_the_held_out_set():
@@ -152,11 +153,10 @@ def test_quadruped_main_job_runs_all_four_lessons_and_resumes_mid_lesson4_exactl
     plan = main_job.plan_from_args(args)
     assert [(l.task, l.steps) for l in plan] == [("lesson1", 64), ("lesson2", 64), ("lesson3", 112), ("lesson4", 60)]
     lessons = main_job.config_from_args(args, [], cls=LessonSettings)
-    options = dict(checkpoint_every=10 ** 6, lessons=lessons,
-                   task_kwargs=main_job.resolve_task_kwargs({}, Domain("robostrich_a1")))
+    spec = RunSpec(plan, TINY, 0, lessons, main_job.resolve_task_kwargs({}, Domain("robostrich_a1")))
 
     def make_run(name):
-        return DomainRun(plan, TINY, 0, str(tmp_path / name), **options)
+        return DomainRun(spec, str(tmp_path / name), checkpoint_every=10 ** 6)
 
     whole = make_run("whole")
     whole.run()

@@ -11,11 +11,13 @@ import numpy as np
 import pytest
 
 from agents.robostrich import figures
-from agents.robostrich.domains import as_domain
+from agents.robostrich.domains import Domain, as_domain
 from agents.robostrich.evaluate import episodes
 from agents.replay import ObservationFlattener
 from robostrich_suite.studies import movement, movement_figure, walk, walk_figure
 from robostrich_suite.tasks import quadruped_tasks
+
+ARM = Domain("robostrich")  # the frame arm with its own routing
 
 
 class ZeroTendons:
@@ -138,7 +140,7 @@ def passive_arm_reports():
     actor = ZeroTendons()
     records, steps = [], 0
     for task in ("lesson1", "lesson2"):
-        report = episodes.evaluate_heldout(actor, flattener, "robostrich", task, num_targets=2)
+        report = episodes.evaluate_heldout(actor, flattener, ARM, task, ARM.heldout_targets(2))
         for episode in report["episodes"]:
             steps += episode["steps"]
             records.append(dict(env_steps=steps, task=task, **{k: episode[k] for k in ("return", "success")}))

@@ -7,7 +7,8 @@ import pytest
 
 from agents.curriculum import LessonSettings
 from agents.replay import ReplayBuffer
-from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, parse_plan
 from agents.sac.config import SACConfig
 
 HER = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=100, max_replay_size=5000,
@@ -16,7 +17,7 @@ HER = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=100, max_r
 
 
 def filled_run(tmp_path, plan="robostrich/lesson2:1500", config=HER, seed=0):
-    run = DomainRun(parse_plan(plan), config, seed=seed, run_dir=str(tmp_path), checkpoint_every=10_000)
+    run = DomainRun(RunSpec(parse_plan(plan), config, seed), str(tmp_path), checkpoint_every=10_000)
     run.run()
     return run
 
@@ -43,8 +44,9 @@ def test_the_inputs_change_charge_survives_recomputed_and_hindsight_rewards(tmp_
     """With ``weights.action_change`` the replay keeps each reward's part no goal changes: recomputed
     for its own goal the reward is the one the task gave (the charge included), and a hindsight
     reward carries the same charge; lesson 1 (eq. 9, no charge) keeps none."""
-    run = DomainRun(parse_plan("robostrich/lesson1:300,robostrich/lesson2:600"), HER, seed=1, run_dir=str(tmp_path),
-                    checkpoint_every=10_000, task_kwargs={"weights": {"action_change": 50.0}})
+    run = DomainRun(RunSpec(parse_plan("robostrich/lesson1:300,robostrich/lesson2:600"), HER, 1,
+                            task_kwargs={"weights": {"action_change": 50.0}}),
+                    str(tmp_path), checkpoint_every=10_000)
     run.run()
     replay, relabeler = run.loop.replay, run.loop.relabeler
     assert relabeler.keeps_goal_free and replay.goal_free is not None
@@ -95,11 +97,11 @@ def test_hindsight_goals_are_reached_later_in_the_same_episode(run):
 
 def test_resumed_her_run_is_bit_exact(tmp_path):
     plan = parse_plan("robostrich/lesson1:600,robostrich/lesson2:600")
-    a = DomainRun(plan, HER, seed=3, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
+    a = DomainRun(RunSpec(plan, HER, 3), str(tmp_path / "a"), checkpoint_every=10_000)
     a.run(until_step=740)  # mid-episode in lesson 2, after learning started
     path = str(tmp_path / "run.ckpt")
     a.save_checkpoint(path)
-    b = DomainRun(plan, HER, seed=3, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
+    b = DomainRun(RunSpec(plan, HER, 3), str(tmp_path / "b"), checkpoint_every=10_000)
     b.restore(path)
     a.run()
     b.run()
@@ -116,13 +118,13 @@ def test_task_kwargs_reach_every_lesson_and_the_checkpoint_fingerprint(tmp_path)
     other weights is refused on resume."""
     plan = parse_plan("robostrich/lesson1:100,robostrich/lesson2:100")
     weights = {"weights": {"position_error": 10.0}}
-    run = DomainRun(plan, HER, seed=0, run_dir=str(tmp_path / "a"), task_kwargs=weights)
+    run = DomainRun(RunSpec(plan, HER, 0, task_kwargs=weights), str(tmp_path / "a"))
     assert run.loop.env.task.weights.position_error == 10.0
     run.run()
     assert run.done
     path = str(tmp_path / "run.ckpt")
     run.save_checkpoint(path)
-    plain = DomainRun(plan, HER, seed=0, run_dir=str(tmp_path / "b"))
+    plain = DomainRun(RunSpec(plan, HER, 0), str(tmp_path / "b"))
     assert plain.loop.env.task.weights.position_error == 2.0
     with pytest.raises(ValueError, match="task_kwargs"):
         plain.restore(path)
@@ -133,7 +135,7 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
     targets, and a run resumed in lesson 2 keeps HER off."""
     plan = parse_plan("robostrich/lesson1:600,robostrich/lesson2:600")
     config, lessons = HER, LessonSettings(her_lessons=("lesson1",))
-    run = DomainRun(plan, config, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000, lessons=lessons)
+    run = DomainRun(RunSpec(plan, config, 1, lessons=lessons), str(tmp_path / "a"), checkpoint_every=10_000)
     assert run.loop.her_ratio == 0.5
     run.run(until_step=800)
     assert run.lesson_index == 1 and run.loop.her_ratio == 0.0
@@ -148,18 +150,18 @@ def test_her_lessons_relabel_only_the_named_lessons_also_after_a_resume(tmp_path
     assert relabelled_share(lessons.her_ratio("lesson1", config)) > 0.3  # what lesson 1 sampled
     path = str(tmp_path / "run.ckpt")
     run.save_checkpoint(path)
-    resumed = DomainRun(plan, config, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000, lessons=lessons)
+    resumed = DomainRun(RunSpec(plan, config, 1, lessons=lessons), str(tmp_path / "b"), checkpoint_every=10_000)
     assert resumed.loop.her_ratio == 0.5  # lesson 1 until the checkpoint says otherwise
     resumed.restore(path)
     assert resumed.loop.her_ratio == 0.0
     with pytest.raises(ValueError, match="her_lessons"):
         LessonSettings(her_lessons="lesson1")  # a string, not a tuple of names
     misspelt = LessonSettings(her_lessons=("lesson_1",))
-    off = DomainRun(plan, dataclasses.replace(HER, her_ratio=0.0), seed=1, run_dir=str(tmp_path / "off"),
-                    lessons=misspelt)  # --her-ratio 0 turns HER off whatever the lessons say
+    off = DomainRun(RunSpec(plan, dataclasses.replace(HER, her_ratio=0.0), 1, lessons=misspelt),
+                    str(tmp_path / "off"))  # --her-ratio 0 turns HER off whatever the lessons say
     assert off.loop.her_ratio == 0.0
     with pytest.raises(ValueError, match=r"her_lessons names \['lesson_1'\]"):
-        DomainRun(plan, HER, seed=1, run_dir=str(tmp_path / "c"), lessons=misspelt)
+        DomainRun(RunSpec(plan, HER, 1, lessons=misspelt), str(tmp_path / "c"))
 
 
 def test_level_goals_only_relabel_with_poses_the_lesson_could_set(run):
@@ -228,8 +230,8 @@ def test_after_a_fresh_replay_lesson_hindsight_goals_still_come_from_the_same_ep
     goes on: hindsight goals must still be poses reached later in the transition's own episode
     (not rows the clear left behind, nor never-written zeros)."""
     plan = parse_plan("robostrich/lesson1:500,robostrich/lesson2:1000")
-    run = DomainRun(plan, HER, seed=2, run_dir=str(tmp_path), checkpoint_every=10_000,
-                    lessons=LessonSettings(fresh_replay_lessons=("lesson2",)))
+    run = DomainRun(RunSpec(plan, HER, 2, lessons=LessonSettings(fresh_replay_lessons=("lesson2",))),
+                    str(tmp_path), checkpoint_every=10_000)
     run.run()
     replay, relabeler = run.loop.replay, run.loop.relabeler
     n = len(replay)

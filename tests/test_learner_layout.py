@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from agents import checkpoint
-from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, parse_plan
 from agents.sac.config import SACConfig
 
 DATA = pathlib.Path(__file__).parent / "data"
@@ -23,8 +24,8 @@ DATA = pathlib.Path(__file__).parent / "data"
 def test_a_run_of_the_earlier_layout_resumes_with_the_same_critics_and_moments(tmp_path, kind, layer_norm, first_layer):
     config = SACConfig(batch_size=16, hidden_sizes=(8, 8), min_replay_size=50, max_replay_size=200,
                        critic_layer_norm=layer_norm)
-    run = DomainRun(parse_plan("robostrich/lesson1:120"), config, seed=5, run_dir=str(tmp_path / "run"),
-                    checkpoint_every=10_000)
+    run = DomainRun(RunSpec(parse_plan("robostrich/lesson1:120"), config, 5),
+                    str(tmp_path / "run"), checkpoint_every=10_000)
     path = str(DATA / f"learner_layout_v1_{kind}.ckpt")
     run.restore(path)
     learner = run.loop.learner

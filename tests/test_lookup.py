@@ -8,13 +8,16 @@ import pytest
 from dm_env import specs
 
 from agents.robostrich.evaluate import episodes, evaluation
-from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, parse_plan
 from agents.robostrich.domains import Domain, as_domain
 from agents.robostrich.lookup import LookupPolicy, lookup_table
 from agents.replay import ObservationFlattener
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
 from robostrich_suite import targets
+
+ARM = Domain("robostrich")  # the frame arm with its own routing
 
 
 @pytest.fixture(scope="module")
@@ -39,7 +42,7 @@ def test_lookup_table_holds_no_pose_at_a_heldout_target():
 def test_lookup_holds_a_stored_training_pose(flattener):
     policy = LookupPolicy(flattener)
     target = targets.training_targets()[0]
-    report = episodes.evaluate_heldout(policy, flattener, "robostrich", "lesson2", targets=target[None])
+    report = episodes.evaluate_heldout(policy, flattener, ARM, "lesson2", target[None])
     episode = report["episodes"][0]
     assert episode["success"], episode
     assert episode["final_position_error"] < 0.01 and episode["final_attitude_error"] < 5.0, episode
@@ -50,8 +53,8 @@ def test_lookup_holds_a_stored_training_pose(flattener):
 def test_precise_success_is_the_share_within_1cm_and_2deg(flattener):
     """The stored poses are level only within the paper's 5 deg: holding them is a success at
     the paper's tolerance, but rarely a precise reach, which evaluations report beside it."""
-    report = episodes.evaluate_heldout(LookupPolicy(flattener), flattener, "robostrich", "lesson2",
-                                         targets=targets.training_targets()[:6])
+    report = episodes.evaluate_heldout(LookupPolicy(flattener), flattener, ARM, "lesson2",
+                                         targets.training_targets()[:6])
     within = [e["final_position_error"] <= 0.01 and abs(e["final_attitude_error"]) <= 2.0
               for e in report["episodes"]]
     assert report["summary"]["precise_success_rate"] == np.mean(within)
@@ -109,7 +112,7 @@ def test_one_hold_per_moving_start_scores_every_target_as_a_hold_before_each_tar
 
 def test_evaluation_on_reacher_reports_returns_not_nan(tmp_path):
     config = SACConfig(batch_size=32, hidden_sizes=(32, 32), min_replay_size=200, max_replay_size=5000)
-    run = DomainRun(parse_plan("reacher/easy:1000"), config, seed=0, run_dir=str(tmp_path / "run"))
+    run = DomainRun(RunSpec(parse_plan("reacher/easy:1000"), config, 0), str(tmp_path / "run"))
     actor = SACBuilder.make_eval_actor(run.loop)  # untrained
     reports = evaluation.evaluate_agent(actor, run.loop.flattener, str(tmp_path / "ev"), "sac", "reacher", "easy",
                                         None, num_targets=2, record=False)
@@ -162,19 +165,19 @@ def test_residual_adapter_offsets_the_lookup_by_a_bounded_correction(flattener, 
     with pytest.raises(ValueError, match="residual scale"):
         ResidualAdapter(spec, lookup, scale=0.0)
     with pytest.raises(ValueError, match="do not mix"):
-        DomainRun(parse_plan("lesson2:100"), SACConfig(her_ratio=0.5), seed=0, run_dir=str(tmp_path / "mix"),
-                  residual_scale=0.25)
+        DomainRun(RunSpec(parse_plan("lesson2:100"), SACConfig(her_ratio=0.5), 0, residual_scale=0.25),
+                  str(tmp_path / "mix"))
 
 
 def test_untrained_residual_agent_is_the_lookup(flattener, tmp_path):
     """The policy's mean head starts at zero, so before any update the residual agent's
     deterministic action is the lookup's and it lands where the lookup lands."""
     config = SACConfig(min_replay_size=10, her_ratio=0.0)
-    run = DomainRun(parse_plan("lesson2:100"), config, seed=0, run_dir=str(tmp_path / "run"), residual_scale=0.25)
+    run = DomainRun(RunSpec(parse_plan("lesson2:100"), config, 0, residual_scale=0.25), str(tmp_path / "run"))
     actor = SACBuilder.make_eval_actor(run.loop)
     target = targets.heldout_targets()[:2]
-    agent = episodes.evaluate_heldout(actor, run.loop.flattener, "robostrich", "lesson2", targets=target)
-    base = episodes.evaluate_heldout(LookupPolicy(flattener), flattener, "robostrich", "lesson2", targets=target)
+    agent = episodes.evaluate_heldout(actor, run.loop.flattener, ARM, "lesson2", target)
+    base = episodes.evaluate_heldout(LookupPolicy(flattener), flattener, ARM, "lesson2", target)
     assert len(agent["episodes"]) == len(base["episodes"]) == 2
     for a, b in zip(agent["episodes"], base["episodes"]):
         assert a["final_position_error"] == pytest.approx(b["final_position_error"], abs=1e-9)

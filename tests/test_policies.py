@@ -10,7 +10,8 @@ import pytest
 from conftest import console_script
 
 import robostrich_suite
-from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, parse_plan
 from agents.robostrich.domains import domain_of
 from agents.robostrich.evaluate.episodes import evaluate_track
 from agents.robostrich.evaluate.policy_export import export_policy
@@ -70,8 +71,7 @@ def test_policy_file_errors_name_the_file(tmp_path):
 def test_exported_policy_acts_as_its_runs_evaluation_actor(tmp_path, gain, fine):
     config = SACConfig(batch_size=16, hidden_sizes=(16, 16), min_replay_size=50, max_replay_size=2000,
                        fine_input_gain=gain, fine_inputs=fine)
-    run = DomainRun(parse_plan("lesson1:300"), config, seed=3, run_dir=str(tmp_path / "run"),
-                        checkpoint_every=300)
+    run = DomainRun(RunSpec(parse_plan("lesson1:300"), config, 3), str(tmp_path / "run"), checkpoint_every=300)
     run.run()
     path = tmp_path / "policy.npz"
     policy = export_policy(str(tmp_path / "run" / "checkpoint.ckpt"), str(path), command="a test")

@@ -11,7 +11,8 @@ import robostrich_suite
 from robostrich_suite import policies
 from agents import checkpoint
 from agents.robostrich.train import command as training
-from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, parse_plan
 from robostrich_suite.tasks import perturbations
 from robostrich_suite.tasks.perturbations import Perturbation
 from conftest import console_script, finish, start
@@ -157,12 +158,12 @@ def test_randomised_training_runs_and_resumes_bit_for_bit(tmp_path):
                                     "vary": True}, "observe_sent_actions": 3}
     plan = parse_plan("robostrich/lesson3:320")
     config = dataclasses.replace(TINY, min_replay_size=100)
-    a = DomainRun(plan, config, seed=2, run_dir=str(tmp_path / "a"), checkpoint_every=10_000, task_kwargs=task_kwargs)
+    a = DomainRun(RunSpec(plan, config, 2, task_kwargs=task_kwargs), str(tmp_path / "a"), checkpoint_every=10_000)
     a.run(until_step=270)  # early in the second episode
     assert a.loop.env.task.randomizer._pending  # actions in flight are part of the checkpoint
     path = str(tmp_path / "run.ckpt")
     a.save_checkpoint(path)
-    b = DomainRun(plan, config, seed=2, run_dir=str(tmp_path / "b"), checkpoint_every=10_000, task_kwargs=task_kwargs)
+    b = DomainRun(RunSpec(plan, config, 2, task_kwargs=task_kwargs), str(tmp_path / "b"), checkpoint_every=10_000)
     b.restore(path)
     assert_same_run(a, b)
     a.run(until_step=310)

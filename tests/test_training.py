@@ -13,7 +13,8 @@ from agents.robostrich.train import main_job
 from agents.robostrich.train import command as training
 from agents.robostrich.train import progress as training_progress
 from agents.curriculum import LessonSettings, format_plan
-from agents.robostrich.domain_run import DEFAULT_LESSONS, DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import DEFAULT_LESSONS, RunSpec, parse_plan
 from agents.sac.config import SACConfig
 
 # The main job's agent (its flags' defaults), small.
@@ -66,12 +67,12 @@ def killed_after(step: int):
 
 def test_checkpoint_round_trips_bit_exactly_and_continues_identically(tmp_path):
     plan = parse_plan("point_mass/easy:700")
-    a = DomainRun(plan, TINY, seed=1, run_dir=str(tmp_path / "a"), checkpoint_every=10_000)
+    a = DomainRun(RunSpec(plan, TINY, 1), str(tmp_path / "a"), checkpoint_every=10_000)
     a.run(until_step=450)  # mid-episode, after learning started
     assert a.loop.learner.num_updates > 0
     path = str(tmp_path / "run.ckpt")
     a.save_checkpoint(path)
-    b = DomainRun(plan, TINY, seed=1, run_dir=str(tmp_path / "b"), checkpoint_every=10_000)
+    b = DomainRun(RunSpec(plan, TINY, 1), str(tmp_path / "b"), checkpoint_every=10_000)
     b.restore(path)
     assert_same_run(a, b)
     a.run()
@@ -104,20 +105,20 @@ def test_killed_and_resumed_run_matches_an_uninterrupted_one(tmp_path):
 
 def test_mismatched_or_damaged_checkpoint_raises(tmp_path):
     plan = parse_plan("point_mass/easy:300")
-    a = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300)
+    a = DomainRun(RunSpec(plan, TINY, 0), str(tmp_path / "a"), checkpoint_every=300)
     a.run()
     other = SACConfig(**{**TINY.to_dict(), "batch_size": 64, "hidden_sizes": (32, 32)})
-    b = DomainRun(plan, other, seed=0, run_dir=str(tmp_path / "b"))
+    b = DomainRun(RunSpec(plan, other, 0), str(tmp_path / "b"))
     with pytest.raises(ValueError, match="batch_size: checkpoint has 32, this run has 64"):
         b.restore(a.checkpoint_path)
-    c = DomainRun(plan, TINY, seed=5, run_dir=str(tmp_path / "c"))
+    c = DomainRun(RunSpec(plan, TINY, 5), str(tmp_path / "c"))
     with pytest.raises(ValueError, match="seed"):
         c.restore(a.checkpoint_path)
     data = bytearray(open(a.checkpoint_path, "rb").read())
     data[len(data) // 2] ^= 0xFF
     damaged = str(tmp_path / "damaged.ckpt")
     open(damaged, "wb").write(bytes(data))
-    d = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "d"))
+    d = DomainRun(RunSpec(plan, TINY, 0), str(tmp_path / "d"))
     with pytest.raises(ValueError, match="damaged"):
         d.restore(damaged)
     open(damaged, "wb").write(bytes(data[:20]))
@@ -129,20 +130,20 @@ def test_checkpoint_whose_fingerprint_lacks_a_field_is_refused_naming_it(tmp_pat
     """A fingerprint without a config field (written before the field existed) is refused naming
     the field, not filled in; the run's own checkpoint restores."""
     plan = parse_plan("point_mass/easy:300")
-    run = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "a"), checkpoint_every=300)
+    run = DomainRun(RunSpec(plan, TINY, 0), str(tmp_path / "a"), checkpoint_every=300)
     run.run()
     payload = checkpoint.load(run.checkpoint_path)
     lacking = run.fingerprint()
     lacking["config"] = {k: v for k, v in lacking["config"].items() if k != "her_ratio"}
     checkpoint.save(str(tmp_path / "lacking.ckpt"), payload, lacking)
     with pytest.raises(ValueError, match=r"her_ratio: checkpoint has '<missing>'"):
-        DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "c")).restore(str(tmp_path / "lacking.ckpt"))
-    DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "d")).restore(run.checkpoint_path)  # its own: fine
+        DomainRun(RunSpec(plan, TINY, 0), str(tmp_path / "c")).restore(str(tmp_path / "lacking.ckpt"))
+    DomainRun(RunSpec(plan, TINY, 0), str(tmp_path / "d")).restore(run.checkpoint_path)  # its own: fine
 
 
 def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
     plan = parse_plan("point_mass/easy:500,point_mass/hard:500")
-    run = DomainRun(plan, TINY, seed=2, run_dir=str(tmp_path), checkpoint_every=10_000)
+    run = DomainRun(RunSpec(plan, TINY, 2), str(tmp_path), checkpoint_every=10_000)
     seen = {}
 
     def on_eval(r):  # called right after the switch to lesson 2
@@ -161,14 +162,14 @@ def test_curriculum_carries_replay_and_parameters_across_lessons(tmp_path):
     assert run.loop.learner is seen["learner"] and run.loop.learner.num_updates > seen["updates"]
     # lesson 2 starts from lesson 1's trained parameters, not a fresh initialisation
     assert any(not np.array_equal(x, y) for x, y in zip(seen["policy"], initial))
-    fresh = DomainRun(plan[1:], TINY, seed=2, run_dir=str(tmp_path / "fresh"))
+    fresh = DomainRun(RunSpec(plan[1:], TINY, 2), str(tmp_path / "fresh"))
     assert any(not np.array_equal(x, y) for x, y in zip(seen["policy"], leaves(fresh.loop.learner.policy_params)))
     assert float(np.exp(run.loop.learner.state.log_alpha)) != TINY.init_temperature
 
 
 def test_action_repeat_holds_actions_and_sums_rewards(tmp_path):
     config = SACConfig(**{**TINY.to_dict(), "action_repeat": 3, "hidden_sizes": (32, 32)})
-    run = DomainRun(parse_plan("point_mass/easy:1000"), config, seed=0, run_dir=str(tmp_path))
+    run = DomainRun(RunSpec(parse_plan("point_mass/easy:1000"), config, 0), str(tmp_path))
     episodes = []
     ran = run.loop.run(1000, on_episode=episodes.append)
     assert ran == 1000 and run.loop.env_steps == 1000  # the episode end cuts the last repeat short
@@ -304,8 +305,8 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
     a run resumed inside the lesson keeps its discount; a misspelt lesson is an error."""
     plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
     long = LessonSettings(long_horizon_lessons=("hard",), long_horizon_discount=0.9)
-    plain = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
-    other = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "long"), checkpoint_every=600, lessons=long)
+    plain = DomainRun(RunSpec(plan, TINY, 0), str(tmp_path / "plain"), checkpoint_every=10_000)
+    other = DomainRun(RunSpec(plan, TINY, 0, lessons=long), str(tmp_path / "long"), checkpoint_every=600)
     assert other.loop.learner.config.discount == 0.99
     for run in (plain, other):
         run.run(until_step=400)
@@ -313,7 +314,7 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
     assert other.loop.learner.config.discount == 0.9 and plain.loop.learner.config.discount == 0.99
     plain.run()
     other.run(until_step=600)
-    resumed = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "long"), lessons=long)
+    resumed = DomainRun(RunSpec(plan, TINY, 0, lessons=long), str(tmp_path / "long"))
     resumed.restore()
     assert resumed.loop.learner.config.discount == 0.9
     other.run()
@@ -323,7 +324,8 @@ def test_long_horizon_lessons_train_with_their_own_discount_and_keep_it_on_resum
                                                         leaves(other.loop.learner.state.q_params))]
     assert all(differs)
     with pytest.raises(ValueError, match=r"long_horizon_lessons names \['lesson3'\]"):
-        DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "bad"), lessons=LessonSettings(long_horizon_lessons=("lesson3",)))
+        DomainRun(RunSpec(plan, TINY, 0, lessons=LessonSettings(long_horizon_lessons=("lesson3",))),
+                  str(tmp_path / "bad"))
     with pytest.raises(ValueError, match="long_horizon_discount must be in"):
         LessonSettings(long_horizon_discount=1.5)
 
@@ -337,8 +339,8 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     plan = parse_plan("point_mass/easy:400,point_mass/hard:400")
     explore = LessonSettings(exploration_lessons=("hard",), exploration_target_entropy_per_action=1.0,
                              exploration_noise_correlation=0.9)
-    plain = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "plain"), checkpoint_every=10_000)
-    other = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "explore"), checkpoint_every=600, lessons=explore)
+    plain = DomainRun(RunSpec(plan, TINY, 0), str(tmp_path / "plain"), checkpoint_every=10_000)
+    other = DomainRun(RunSpec(plan, TINY, 0, lessons=explore), str(tmp_path / "explore"), checkpoint_every=600)
     actions = other.loop.learner.networks.action_size
     assert other.loop.learner.config.resolved_target_entropy(actions) == -2.0 * actions
     for run in (plain, other):
@@ -348,7 +350,7 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     assert other.loop.learner.config.resolved_target_entropy(actions) == 1.0 * actions
     plain.run()
     other.run(until_step=600)
-    resumed = DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "explore"), lessons=explore)
+    resumed = DomainRun(RunSpec(plan, TINY, 0, lessons=explore), str(tmp_path / "explore"))
     resumed.restore()
     assert resumed.loop.learner.config.resolved_target_entropy(actions) == 1.0 * actions
     assert resumed.loop.actor.noise_correlation == 0.9 and plain.loop.actor.noise_correlation == 0.0
@@ -362,6 +364,7 @@ def test_exploration_lessons_steer_to_their_own_target_entropy_and_keep_it_on_re
     # Over the second lesson the plain run's temperature keeps falling, the explorer's turns up.
     assert temperature["explore"] > at_switch > temperature["plain"], (at_switch, temperature)
     with pytest.raises(ValueError, match=r"exploration_lessons names \['lesson3'\]"):
-        DomainRun(plan, TINY, seed=0, run_dir=str(tmp_path / "bad"), lessons=LessonSettings(exploration_lessons=("lesson3",)))
+        DomainRun(RunSpec(plan, TINY, 0, lessons=LessonSettings(exploration_lessons=("lesson3",))),
+                  str(tmp_path / "bad"))
     with pytest.raises(ValueError, match="exploration_target_entropy_per_action must be finite"):
         LessonSettings(exploration_target_entropy_per_action=float("nan"))

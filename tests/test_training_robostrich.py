@@ -7,9 +7,14 @@ import pytest
 
 from agents.robostrich.evaluate import command as evaluate_command
 from agents.robostrich.evaluate import episodes
-from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.domains import Domain
+from agents.robostrich.run_spec import RunSpec, parse_plan
 from agents.sac.builder import SACBuilder
 from agents.sac.config import SACConfig
+
+ARM = Domain("robostrich")  # the frame arm with its own routing
+
 
 # Small but real: lesson 1 (eq. 9, position only) on the default arm and target set, with the
 # agent's improvements on (hindsight relabelling, layer-normed critics, a low initial temperature).
@@ -24,14 +29,14 @@ STEPS = 12_000
 def position_report(run):
     """Held-out targets, lesson 1 criterion: final head position within 0.05 m (attitude is not trained yet)."""
     actor = SACBuilder.make_eval_actor(run.loop)
-    report = episodes.evaluate_heldout(actor, run.loop.flattener, "robostrich", "lesson1")
+    report = episodes.evaluate_heldout(actor, run.loop.flattener, ARM, "lesson1", ARM.heldout_targets())
     errors = np.array([e["final_position_error"] for e in report["episodes"]])
     return float(np.mean(errors <= 0.05)), float(np.median(errors))
 
 
 @pytest.mark.long
 def test_short_lesson1_training_improves_success_on_heldout_targets(tmp_path):
-    run = DomainRun(parse_plan(f"robostrich/lesson1:{STEPS}"), CONFIG, seed=0, run_dir=str(tmp_path))
+    run = DomainRun(RunSpec(parse_plan(f"robostrich/lesson1:{STEPS}"), CONFIG, 0), str(tmp_path))
     untrained_success, untrained_error = position_report(run)
     run.run()
     trained_success, trained_error = position_report(run)

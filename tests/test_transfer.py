@@ -16,7 +16,8 @@ from robostrich_suite.tasks import quadruped_tasks
 from agents import checkpoint
 from agents.robostrich.train import transfer
 from agents.robostrich.train.main_job import MAIN_JOB_SAC
-from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, parse_plan
 from agents.sac.config import SACConfig
 from test_cli import assert_succeeded, assert_user_error, call, finish, start
 
@@ -32,8 +33,8 @@ A1_PLAN = parse_plan("robostrich_a1/lesson2:100")
 @pytest.fixture(scope="module")
 def source(tmp_path_factory):
     """A trained robostrich run (temperature and Adam moments moved off their start) and its checkpoint."""
-    run = DomainRun(parse_plan("robostrich/lesson2:300"), TINY, 0, str(tmp_path_factory.mktemp("source")),
-                        checkpoint_every=10 ** 6)
+    run = DomainRun(RunSpec(parse_plan("robostrich/lesson2:300"), TINY, 0),
+                    str(tmp_path_factory.mktemp("source")), checkpoint_every=10 ** 6)
     run.run()
     assert run.loop.learner.num_updates > 0
     return run, run.checkpoint_path
@@ -41,7 +42,7 @@ def source(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def transferred(source, tmp_path_factory):
-    run = DomainRun(A1_PLAN, TINY, 1, str(tmp_path_factory.mktemp("a1")))
+    run = DomainRun(RunSpec(A1_PLAN, TINY, 1), str(tmp_path_factory.mktemp("a1")))
     transfer.initialize(run, source[1])
     return run
 
@@ -95,8 +96,8 @@ def test_transferred_networks_act_and_judge_as_the_source_on_corresponding_state
                                   jax.tree_util.tree_leaves(t.policy_params)[0])
     assert float(t.log_alpha) == float(s.log_alpha) != 0.0
     assert int(t.policy_opt_state[0].count) == int(s.policy_opt_state[0].count) > 0
-    assert int(t.steps) == 0 and transferred.fingerprint()["init_from"] == transferred.init_from
-    assert transferred.init_from == open(source[1], "rb").read(40)[8:].hex()
+    assert int(t.steps) == 0 and transferred.fingerprint()["init_from"] == transferred.spec.init_from
+    assert transferred.spec.init_from == open(source[1], "rb").read(40)[8:].hex()
 
 
 def new_input_rows(run):
@@ -169,11 +170,11 @@ def test_checkpoints_that_cannot_start_the_run_are_refused(source, tmp_path):
     (tmp_path / "junk.ckpt").write_bytes(b"not a checkpoint")
     with pytest.raises(checkpoint.CheckpointError):
         transfer.check_source(str(tmp_path / "junk.ckpt"), A1_PLAN, TINY)
-    fresh = DomainRun(A1_PLAN, TINY, 1, str(tmp_path / "a1"))
+    fresh = DomainRun(RunSpec(A1_PLAN, TINY, 1), str(tmp_path / "a1"))
     with pytest.raises(transfer.TransferError, match="has changed"):
         transfer.initialize(fresh, path, digest="0" * 64)
     # The same domain with the same layout: a plain copy of the learner.
-    same = DomainRun(parse_plan("robostrich/lesson3:100"), TINY, 5, str(tmp_path / "same"))
+    same = DomainRun(RunSpec(parse_plan("robostrich/lesson3:100"), TINY, 5), str(tmp_path / "same"))
     transfer.initialize(same, path)
     for a, b in zip(jax.tree_util.tree_leaves(same.loop.learner.state[:7]),
                     jax.tree_util.tree_leaves(run.loop.learner.state[:7])):
@@ -206,7 +207,7 @@ def test_a_target_that_keeps_a_policy_average_starts_it_at_the_source_s(source, 
     import dataclasses
     source_state = jax.tree_util.tree_map(np.asarray, source[0].loop.learner.state)
     assert source_state.average_policy_params is not None  # TINY keeps the default average
-    run = DomainRun(A1_PLAN, dataclasses.replace(TINY, policy_average=0.01), 1, str(tmp_path))
+    run = DomainRun(RunSpec(A1_PLAN, dataclasses.replace(TINY, policy_average=0.01), 1), str(tmp_path))
     obs_map = transfer.ObservationMap.between(source[0].loop.flattener.describe(), run.loop.flattener.describe(),
                                               *transfer.correspondence("robostrich", "robostrich_a1"))
     fresh = run.loop.learner.get_state()

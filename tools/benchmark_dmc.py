@@ -15,7 +15,8 @@ import os
 import sys
 import time
 from collections import deque
-from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, parse_plan
 from agents.robostrich.evaluate import episodes
 from agents.robostrich.train.main_job import MAIN_JOB_SAC  # robostrich-train's agent, these flags on top
 from agents.sac.builder import SACBuilder
@@ -145,7 +146,7 @@ def train_and_evaluate(task, seed, steps, eval_at, config, args, progress, on_ro
     """One SAC run on `task`; `on_row(row)` after each deterministic evaluation."""
     domain, task_name = task.split("/")
     run_dir = os.path.join(args.out, task.replace("/", "_"), f"seed_{seed}")
-    run = DomainRun(parse_plan(f"{task}:{steps}"), config, seed, run_dir, checkpoint_every=steps, name=task)
+    run = DomainRun(RunSpec(parse_plan(f"{task}:{steps}"), config, seed), run_dir, checkpoint_every=steps, name=task)
     for path in (run.metrics_path, run.evals_path):  # a fresh run: no records of an earlier one
         if os.path.exists(path):
             os.unlink(path)
@@ -156,8 +157,8 @@ def train_and_evaluate(task, seed, steps, eval_at, config, args, progress, on_ro
         while pending and pending[0] <= r.loop.env_steps:
             step = pending.pop(0)
             actor = SACBuilder.make_eval_actor(r.loop)
-            report = episodes.evaluate_heldout(actor, r.loop.flattener, domain, task_name,
-                                                 num_targets=args.eval_episodes, action_repeat=config.action_repeat)
+            report = episodes.evaluate_heldout(actor, r.loop.flattener, r.domain(), task_name, None,
+                                               args.eval_episodes, action_repeat=config.action_repeat)
             s = report["summary"]
             on_row({"task": task, "seed": seed, "eval_step": step, "env_steps": r.loop.env_steps,
                     "return_mean": s["return_mean"], "return_std": s["return_std"],

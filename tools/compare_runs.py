@@ -18,7 +18,7 @@ import numpy as np
 
 from agents.robostrich import figures
 from agents.robostrich.sweep import table as sweep_table
-from agents.robostrich.domain_run import parse_plan
+from agents.robostrich.run_spec import parse_plan
 
 KINDS = ("heldout", "heldout_moving")
 

@@ -13,7 +13,8 @@ from agents.replay import ObservationFlattener
 from agents.robostrich.evaluate import episodes, evaluation
 from agents.robostrich.lookup import lookup_table, LookupPolicy
 from agents.robostrich.train.main_job import FIXED_START_ARM_TASK_KWARGS, MAIN_JOB_SAC
-from agents.robostrich.domain_run import DomainRun, parse_plan
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, parse_plan
 from agents.sac.builder import SACBuilder
 from robostrich_suite import targets
 from robostrich_suite import cli as cli_lib
@@ -60,9 +61,9 @@ def curriculum_success(case, target_path: pathlib.Path, options, steps: int = DE
 
     per_lesson = max(steps // 3, 1)
     plan = parse_plan(",".join(f"lesson{i}:{per_lesson}" for i in (1, 2, 3)))
-    run = DomainRun(plan, MAIN_JOB_SAC, options.seed, str(options.out / "train" / case.label),
-                    checkpoint_every=10 ** 9, env_factory=env_factory, name=case.label,
-                    task_kwargs=FIXED_START_ARM_TASK_KWARGS)
+    run = DomainRun(RunSpec(plan, MAIN_JOB_SAC, options.seed, task_kwargs=FIXED_START_ARM_TASK_KWARGS),
+                    str(options.out / "train" / case.label), checkpoint_every=10 ** 9, env_factory=env_factory,
+                    name=case.label)
     run.run()
     actor = SACBuilder.make_eval_actor(run.loop)
     summary = heldout_success(case, targets.heldout_targets(target_path), lambda flattener: actor)

@@ -82,7 +82,8 @@ def main(argv=None) -> dict:
     os.makedirs(args.out, exist_ok=True)
     print(f"{args.policy} ({domain.describe()}, seed {policy.info.get('seed')}, "
           f"{policy.info.get('env_steps')} control steps of training)", flush=True)
-    reports = {"heldout": episodes.evaluate_heldout(policy, policy.flatten, domain, heldout_task, args.num_targets)}
+    reports = {"heldout": episodes.evaluate_heldout(policy, policy.flatten, domain, heldout_task,
+                                                    domain.heldout_targets(args.num_targets), args.num_targets)}
     print(f"heldout  {evaluation.outcome_text('heldout', reports['heldout']['summary'])}", flush=True)
     second, play = ("head_stabilize", play_stabilize) if domain.on_quadruped else ("track", play_track)
     label = policy_label(args.policy)

@@ -13,7 +13,7 @@ from typing import Optional
 import numpy as np
 
 from agents.robostrich import figures
-from agents.robostrich.domain_run import parse_plan
+from agents.robostrich.run_spec import parse_plan
 from agents.robostrich.domains import as_domain
 from agents.robostrich.evaluate.evaluation import (MAX_TARGETS, check_heldout_task, check_track_task,
                                                     checked_fingerprint, checkpoint_domain, default_heldout_task,

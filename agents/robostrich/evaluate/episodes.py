@@ -6,7 +6,7 @@ from typing import Optional
 
 import numpy as np
 
-from agents.robostrich.domains import as_domain
+from agents.robostrich.domains import Domain, as_domain
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.tasks import measurement
 from robostrich_suite.tasks.conventions import PRECISE_ATTITUDE_TOLERANCE_DEG, PRECISE_POSITION_TOLERANCE
@@ -104,20 +104,17 @@ def summarize(episodes) -> dict:
     }
 
 
-def evaluate_heldout(actor, flattener, domain, task: str, num_targets: Optional[int] = None,
-                     seed: int = 10_000, targets=None, action_repeat: int = 1, on_episode=None,
-                     kind: str = "heldout") -> dict:
-    """Deterministic policy, one episode per held-out target (a pool of that single target).
+def evaluate_heldout(actor, flattener, domain: Domain, task: str, targets, count: Optional[int] = None,
+                     seed: int = 10_000, action_repeat: int = 1, on_episode=None, kind: str = "heldout") -> dict:
+    """Deterministic policy, one episode per target of ``targets`` (a pool of that single target; the
+    domain's held-out ones: ``Domain.heldout_targets``); None off the arm: ``count`` (default 10)
+    episodes seeded from ``seed``, judged by their returns.
 
     Use a task with a fixed initial state (lesson2): every target then starts from the same pose.
-    The domain's held-out targets (None off the arm: seeded episodes) unless ``targets`` are given.
     """
-    domain = as_domain(domain)
     report = {"kind": kind, **domain.info(), "task": task}
-    if targets is None:
-        targets = domain.heldout_targets(num_targets)
     episodes = []
-    count = len(targets) if targets is not None else (num_targets or 10)
+    count = len(targets) if targets is not None else (count or 10)
     env = None
     for i in range(count):
         if targets is None:

@@ -15,14 +15,13 @@ import tempfile
 from typing import Optional
 
 from agents import checkpoint
-from agents.curriculum import LessonSettings
 from agents.replay import ObservationFlattener
 from agents.robostrich.domains import as_domain, domain_of, TRACK_TASK
 from agents.robostrich.lookup import LABEL, LookupPolicy
 from agents.robostrich.evaluate import episodes, lookup_cache
 from agents.robostrich.recording import open_recorder
-from agents.robostrich.domain_run import DomainRun, current_fingerprint, parse_plan
-from agents.sac.config import SACConfig
+from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec, migrate, parse_plan
 from robostrich_suite import atomic_files, parsing
 from robostrich_suite import cli as cli_lib
 
@@ -71,15 +70,17 @@ def evaluate_agent(actor, flattener, out_dir: str, label: str, domain, heldout_t
     domain's frame, or None) and track evaluation, JSON reports and (optionally) a Rerun
     recording of the track rollout. ``on_episode()`` is called after each of its `episode_count` episodes."""
     os.makedirs(out_dir, exist_ok=True)
-    moving = as_domain(domain).has_moving_starts
-    reports = {"heldout": episodes.evaluate_heldout(actor, flattener, domain, heldout_task, num_targets,
-                                           action_repeat=action_repeat, on_episode=on_episode)}
+    domain = as_domain(domain)
+    moving = domain.has_moving_starts
+    reports = {"heldout": episodes.evaluate_heldout(actor, flattener, domain, heldout_task,
+                                                    domain.heldout_targets(num_targets), num_targets,
+                                                    action_repeat=action_repeat, on_episode=on_episode)}
     if moving:
         reports["heldout_moving"] = episodes.evaluate_heldout_moving(actor, flattener, domain, num_targets,
                                                             action_repeat=action_repeat, on_episode=on_episode)
     if new_targets is not None and len(new_targets):
-        reports["new"] = episodes.evaluate_heldout(actor, flattener, domain, heldout_task, targets=new_targets,
-                                          action_repeat=action_repeat, on_episode=on_episode, kind="new")
+        reports["new"] = episodes.evaluate_heldout(actor, flattener, domain, heldout_task, new_targets,
+                                                   action_repeat=action_repeat, on_episode=on_episode, kind="new")
         if moving:
             reports["new_moving"] = episodes.evaluate_heldout_moving(actor, flattener, domain, targets=new_targets,
                                                             action_repeat=action_repeat, on_episode=on_episode,
@@ -178,7 +179,7 @@ def checked_fingerprint(path: str) -> dict:
     """The fingerprint of a robostrich-train checkpoint, after checking that it holds
     what a run is rebuilt from: a CheckpointError naming what it lacks, before anything is built."""
     record, _ = checkpoint.read_with_digest(path)
-    fp = current_fingerprint(record["fingerprint"])
+    fp = migrate(record["fingerprint"])
     missing = ([k for k in ("plan", "config", "lessons", "seed") if k not in fp]
                + [k for k in DomainRun.STATE_FIELDS if k not in record["payload"]])
     if missing:
@@ -201,9 +202,7 @@ def load_run_from_checkpoint(path: str):
     fp = checked_fingerprint(path)
     scratch = tempfile.mkdtemp(prefix="robostrich-evaluate-")  # the run's own files are left untouched
     try:
-        run = DomainRun(parse_plan(fp["plan"]), SACConfig.from_dict(fp["config"]), fp["seed"], scratch,
-                        task_kwargs=fp.get("task_kwargs"), layout=fp.get("layout"), init_from=fp.get("init_from"),
-                        lessons=LessonSettings.from_dict(fp["lessons"]), residual_scale=fp.get("residual_scale", 0.0))
+        run = DomainRun(RunSpec.from_fingerprint(fp), scratch)
         run.restore(path)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)

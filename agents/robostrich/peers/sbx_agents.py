@@ -121,7 +121,7 @@ def train(spec: PeerSpec) -> dict:
             lesson_now = lesson
         model.learn(steps, reset_num_timesteps=False)
         report = episodes.evaluate_heldout(PeerActor(model, env), flattener, domain, spec.heldout_task,
-                                             spec.num_eval_targets)
+                                             domain.heldout_targets(spec.num_eval_targets), spec.num_eval_targets)
         curve.append({"env_steps": int(model.num_timesteps), "summary": report["summary"]})
         with open(os.path.join(spec.out, "evals.jsonl"), "a") as f:
             f.write(json.dumps(curve[-1]) + "\n")

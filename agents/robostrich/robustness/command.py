@@ -118,7 +118,8 @@ def evaluate(evaluated: Evaluated, perturbation, num_targets) -> dict:
     domain = PerturbedDomain(evaluated.domain, perturbation)
     task = evaluation.default_heldout_task(domain, "track")
     reports = {"heldout": episodes.evaluate_heldout(evaluated.actor, evaluated.flattener, domain, task,
-                                                      num_targets, action_repeat=evaluated.action_repeat)}
+                                                      domain.heldout_targets(num_targets), num_targets,
+                                                      action_repeat=evaluated.action_repeat)}
     if domain.has_moving_starts:
         reports["heldout_moving"] = episodes.evaluate_heldout_moving(
             evaluated.actor, evaluated.flattener, domain, num_targets, action_repeat=evaluated.action_repeat)

@@ -10,6 +10,7 @@ from agents.robostrich.evaluate import evaluation
 from agents.robostrich.domains import Domain
 from agents.robostrich.train.main_job import config_from_args, plan_from_args, resolve_layout, resolve_task_kwargs, with_flags
 from agents.robostrich.domain_run import check_lesson_names
+from agents.robostrich.run_spec import RunSpec
 from agents.replay import ObservationFlattener
 from agents.sac.config import SACConfig
 from robostrich_suite import parsing
@@ -107,6 +108,12 @@ class TrainingSetup:
     heldout_task: str
     track_task: Optional[str]
     run_plans: dict
+
+    def run_spec(self, args, label: str, init_from: Optional[str] = None) -> RunSpec:
+        """The run ``label`` (curriculum, baseline) of this command line; ``init_from``: the content
+        hash of the checkpoint its learner starts from."""
+        return RunSpec(self.run_plans[label], self.config, args.seed, self.lessons, args.task_kwargs, args.layout,
+                       init_from, self.residual_scale)
 
 
 def prepare(args, argv) -> TrainingSetup:

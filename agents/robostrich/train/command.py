@@ -27,9 +27,9 @@ from agents.robostrich.train.main_job import (DEFAULT_ARM_LAYOUT, DEFAULT_ARM_TA
                                               FRAME_TASK_KWARGS, MAIN_JOB_BY_DOMAIN, MAIN_JOB_LESSON_SHARES,
                                               MAIN_JOB_SAC, MAIN_JOB_STEPS, QUADRUPED_TASK_KWARGS, positive_int)
 from agents.robostrich.train.run_directory import check_run_directory, finished_summary, lock_run_directory, previous_init_path
-from agents.robostrich.domain_run import DEFAULT_LESSONS
+from agents.robostrich.run_spec import DEFAULT_LESSONS
 from agents.robostrich.train.checks import TrainingSetup, json_object, prepare, randomize_scales
-from agents.robostrich.train.jobs import LookupSpec, RunJob, RunSpec, step_boundaries, final_targets, \
+from agents.robostrich.train.jobs import LookupSpec, PendingRun, RunJob, step_boundaries, final_targets, \
     lesson_end_evaluations, read_jsonl, train_and_evaluate
 from agents.robostrich.train.progress import Progress
 from agents.robostrich.train.workers import train_in_parallel
@@ -188,14 +188,10 @@ def start_runs(args, argv, setup: TrainingSetup, init: dict):
     """The runs' specs (and, trained here, the runs themselves, restored on --resume); a run that
     died before its first checkpoint loses its records; config.json. Returns (specs, runs)."""
     transferred = {"curriculum": init} if init else {}  # the baseline starts from scratch
-    specs = {label: RunSpec(dict(plan=list(run_plan), config=setup.config, seed=args.seed,
-                                 run_dir=os.path.join(args.out, label), checkpoint_every=args.checkpoint_every,
-                                 name=label, task_kwargs=args.task_kwargs, layout=args.layout,
-                                 init_from=transferred.get(label, {}).get("init_digest"),
-                                 keep_lesson_checkpoints=args.keep_lesson_checkpoints, lessons=setup.lessons,
-                                 residual_scale=setup.residual_scale),
-                            transfer_from=transferred.get(label, {}).get("init_from"))
-             for label, run_plan in setup.run_plans.items()}
+    specs = {label: PendingRun(setup.run_spec(args, label, transferred.get(label, {}).get("init_digest")),
+                               os.path.join(args.out, label), label, args.checkpoint_every,
+                               args.keep_lesson_checkpoints, transfer_from=transferred.get(label, {}).get("init_from"))
+             for label in setup.run_plans}
     # Sequential: build (and restore) every run here; parallel: the workers do, once each.
     runs = {} if _parallel(args, specs) else {label: spec.build(restore=args.resume) for label, spec in specs.items()}
     # Every checkpoint is checked: only now change the run directory (a rejected resume leaves it as it was).

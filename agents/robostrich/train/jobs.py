@@ -1,7 +1,6 @@
 """What each of robostrich-train's runs is given and does: the run's description (picklable,
 for a worker), its periodic and final evaluations, and the lookup's evaluation as a job of its own."""
 import dataclasses
-import inspect
 import json
 import os
 import time
@@ -15,6 +14,7 @@ from agents.robostrich.train import transfer
 from agents.robostrich.domains import Domain
 from agents.robostrich.lookup import LABEL as LOOKUP_LABEL
 from agents.robostrich.domain_run import DomainRun
+from agents.robostrich.run_spec import RunSpec
 from agents.sac.builder import SACBuilder
 from robostrich_suite import cli as cli_lib
 from robostrich_suite import atomic_files
@@ -41,30 +41,22 @@ class RunJob:
 
 
 @dataclasses.dataclass(frozen=True)
-class RunSpec:
-    """A run not built yet (picklable): ``DomainRun``'s own keyword arguments, the one description
-    of a run, so that the parent of a parallel job passes it to a worker instead of building the
-    run (networks, replay, environment) itself, which it would only throw away. ``transfer_from``:
-    a checkpoint a fresh run's learner starts from (agents/robostrich/train/transfer.py; its content
-    hash is the run's ``init_from``)."""
+class PendingRun:
+    """A run not built yet (picklable): its description and where it trains, so that the parent of a
+    parallel job passes it to a worker instead of building the run (networks, replay, environment)
+    itself, which it would only throw away. ``transfer_from``: a checkpoint a fresh run's learner
+    starts from (agents/robostrich/train/transfer.py; its content hash is the spec's ``init_from``)."""
 
-    arguments: dict
+    spec: RunSpec
+    run_dir: str
+    label: str
+    checkpoint_every: int
+    keep_lesson_checkpoints: bool = False
     transfer_from: Optional[str] = None
 
-    def __post_init__(self):
-        inspect.signature(DomainRun).bind(**self.arguments)  # a misnamed argument fails here, not in a worker
-
     @property
-    def label(self) -> str:
-        return self.arguments["name"]
-
-    @property
-    def plan(self) -> list:
-        return self.arguments["plan"]
-
-    @property
-    def run_dir(self) -> str:
-        return self.arguments["run_dir"]
+    def plan(self) -> tuple:
+        return self.spec.plan
 
     @property
     def total_steps(self) -> int:
@@ -73,11 +65,12 @@ class RunSpec:
     def build(self, restore: bool) -> DomainRun:
         """The run; restored from its checkpoint when ``restore`` and one exists (raises on a
         damaged or mismatched checkpoint, never restarts silently)."""
-        run = DomainRun(**self.arguments)
+        run = DomainRun(self.spec, self.run_dir, self.checkpoint_every, name=self.label,
+                        keep_lesson_checkpoints=self.keep_lesson_checkpoints)
         if restore and os.path.exists(run.checkpoint_path):
             run.restore()
         elif self.transfer_from is not None:
-            transfer.initialize(run, self.transfer_from, self.arguments.get("init_from"))
+            transfer.initialize(run, self.transfer_from, self.spec.init_from)
         return run
 
 
@@ -114,9 +107,10 @@ def train_and_evaluate(run: DomainRun, job: RunJob, progress=None) -> dict:
         def on_eval(r):
             actor = SACBuilder.make_eval_actor(r.loop)
             lesson_end = r.loop.env_steps in step_boundaries(r.plan)[:-1]  # evaluated on every held-out target
-            targets = final_targets(job) if lesson_end else job.num_eval_targets
+            count = final_targets(job) if lesson_end else job.num_eval_targets
             report = episodes.evaluate_heldout(actor, r.loop.flattener, job.domain, job.heldout_task,
-                                                 targets, action_repeat=config.action_repeat)
+                                               job.domain.heldout_targets(count), count,
+                                               action_repeat=config.action_repeat)
             record = {"env_steps": r.loop.env_steps, "lessons_completed": r.lesson_index, "summary": report["summary"]}
             if lesson_end:
                 record["lesson_end"] = True

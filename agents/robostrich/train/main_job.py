@@ -6,7 +6,7 @@ from typing import Optional
 from agents import config_flags
 from agents.curriculum import Lesson, LessonSettings
 from agents.robostrich.domains import Domain
-from agents.robostrich.domain_run import parse_plan
+from agents.robostrich.run_spec import parse_plan
 from agents.sac.config import SACConfig
 from robostrich_suite import cli as cli_lib
 from robostrich_suite.model import layouts

@@ -8,7 +8,7 @@ from agents import checkpoint
 from agents.curriculum import read_records, run_files
 from agents.robostrich import directory_lock
 from agents.robostrich.train import transfer
-from agents.robostrich.domain_run import current_fingerprint, run_identity
+from agents.robostrich.run_spec import migrate
 from agents.robostrich.train.checks import TrainingSetup
 from robostrich_suite import parsing
 
@@ -61,16 +61,14 @@ def _check_resumed(args, setup: TrainingSetup, label: str, init: dict) -> dict:
     """One run's checkpoint against this command line (and its records' lines); the --init-from
     a started curriculum recorded."""
     path = os.path.join(args.out, label, checkpoint.FILE_NAME)
-    stored = current_fingerprint(checkpoint.read_fingerprint(path))
+    stored = migrate(checkpoint.read_fingerprint(path))
     if label == "curriculum":  # a started run's learner is in its checkpoint: --init-from may be left out
         if init and stored.get("init_from") != init["init_digest"]:
             raise ValueError(f"{path} did not start from --init-from {args.init_from} "
                              + ("(nor from any checkpoint)" if "init_from" not in stored else
                                 "(it started from another checkpoint, or that file has changed since)"))
         init = {**init, "init_digest": stored["init_from"]} if "init_from" in stored else {}
-    expected = run_identity(setup.run_plans[label], setup.config, args.seed, setup.lessons, args.task_kwargs,
-                            args.layout, init.get("init_digest") if label == "curriculum" else None,
-                            setup.residual_scale)
+    expected = setup.run_spec(args, label, init.get("init_digest") if label == "curriculum" else None).identity()
     checkpoint.check_fingerprint({k: stored.get(k, "<missing>") for k in expected}, expected, path)
     for records in run_files(os.path.join(args.out, label))[1:]:
         read_records(records)  # a damaged line other than a torn last one, named

@@ -30,7 +30,7 @@ import numpy as np
 from jax.flatten_util import ravel_pytree
 
 from agents import checkpoint, trees
-from agents.robostrich.domain_run import named_layout, parse_plan
+from agents.robostrich.run_spec import migrate, named_layout, parse_plan
 from agents.robostrich.train.main_job import MAIN_JOB_SAC
 from agents.sac import state_layout
 from agents.sac.config import SACConfig
@@ -232,7 +232,7 @@ def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = Non
         record, digest = _read(path)
     else:
         record, digest = record
-    fingerprint = record["fingerprint"]
+    fingerprint = migrate(record["fingerprint"])
     missing = [k for k in ("plan", "config", "observation_layout", "action_size") if k not in fingerprint]
     missing += [k for k in ("learner",) if k not in record["payload"]]
     if missing:
@@ -258,14 +258,14 @@ def check_source(path: str, plan, config: SACConfig, layout: Optional[str] = Non
 
 
 def initialize(run, path: str, digest: Optional[str] = None) -> InitSource:
-    """Start `run` (a fresh CurriculumRun) from the checkpoint at `path` (module doc) and record the
+    """Start `run` (a fresh DomainRun) from the checkpoint at `path` (module doc) and record the
     checkpoint's content hash as the run's ``init_from``; `digest`: the hash the run was set up with
     (robostrich-train checks the file first), TransferError if the file has changed since."""
     record, found = _read(path)
     if digest is not None and found != digest:
         raise TransferError(f"--init-from: {path} has changed since this run was set up from it")
     source = check_source(path, run.plan, run.config, run.layout, record=(record, found),
-                          residual_scale=getattr(run, "residual_scale", 0.0))
+                          residual_scale=run.residual_scale)
     if source.fingerprint["action_size"] != run.loop.actor.adapter.size:
         raise TransferError(f"--init-from: {path} acts with {source.fingerprint['action_size']} actions, "
                             f"this run with {run.loop.actor.adapter.size}")
@@ -276,5 +276,6 @@ def initialize(run, path: str, digest: Optional[str] = None) -> InitSource:
     fresh = learner.get_state()
     learner.set_state(transfer_state(stored_learner(record["payload"]["learner"], fresh, path), fresh, obs_map))
     run.loop.actor.update(learner.policy_params)
-    run.init_from = source.digest  # into the run's fingerprint: a resume knows where it started
+    # into the run's fingerprint: a resume knows where it started
+    run.spec = dataclasses.replace(run.spec, init_from=source.digest)
     return source

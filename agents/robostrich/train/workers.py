@@ -6,12 +6,12 @@ import queue as queue_lib
 import signal
 
 from agents.robostrich.evaluate import evaluation
-from agents.robostrich.train.jobs import LookupSpec, RunJob, RunSpec, train_and_evaluate
+from agents.robostrich.train.jobs import LookupSpec, PendingRun, RunJob, train_and_evaluate
 from agents.robostrich.train.progress import QueueProgress
 from robostrich_suite import cli as cli_lib
 
 
-def _worker(spec: RunSpec, job, queue):
+def _worker(spec: PendingRun, job, queue):
     """One run in its own process: restore its latest checkpoint (if any), train, evaluate.
     Ctrl-C (the terminal's, or the parent's on another run's error) writes a checkpoint first."""
     label = spec.label
