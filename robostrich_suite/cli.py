@@ -31,15 +31,17 @@ import sys
 import threading
 from typing import Callable, Optional, Sequence
 
+from robostrich_suite import parsing
+
 USER_ERROR = 2
 INTERRUPTED = 130  # 128 + SIGINT
 TERMINATED = 143  # 128 + SIGTERM
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)  # both stop a command the same way (module doc)
 CHECKPOINT_WRITTEN = "checkpoint written"  # how an interrupt that saved its work begins its message
 
-# Generous but finite limits of what a flag may ask for.
-MAX_COUNT = 10_000_000  # samples, targets, rollouts: more than a day of simulation on 2 cores
-MAX_SECONDS = 600.0  # simulated seconds of one episode, hold or ramp
+# Generous but finite limits of what a flag may ask for (and, beside these, parsing's).
+MAX_COUNT = parsing.MAX_COUNT
+MAX_SECONDS = parsing.MAX_SECONDS
 MAX_WORKERS = 256  # processes
 MAX_SEED = 2**31 - 1 - 100_000  # seeds with offsets added stay 32-bit
 

@@ -14,6 +14,11 @@ import tomllib
 
 from robostrich_suite import input_files
 
+# Generous but finite limits of what a flag or a task option may ask for (the commands' flags:
+# robostrich_suite/cli.py; the tasks' options: robostrich_suite/tasks/options.py).
+MAX_COUNT = 10_000_000  # samples, targets, rollouts: more than a day of simulation on 2 cores
+MAX_SECONDS = 600.0  # simulated seconds of one episode, hold or ramp
+
 MAX_DEPTH = 64  # levels of nested arrays and objects; what the project writes stays under 10
 
 

@@ -1,5 +1,6 @@
-"""The package's layers import downwards only: model -> physics -> tasks -> domains, studies beside
-them, and robostrich_suite never imports the agent (a simulation user needs no JAX)."""
+"""The package's layers import downwards only: model -> physics -> tasks -> domains, the suite a
+simulation user loads; above it the command kit (flags, outputs, progress, workers, the viewer) and
+the studies; and robostrich_suite never imports the agent (a simulation user needs no JAX)."""
 import ast
 import pathlib
 import subprocess
@@ -9,13 +10,16 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "robostrich_suite"
-# Each module's layer; a module may import from its own layer and the ones below it.
-LAYERS = ("utilities", "model", "physics", "tasks", "domains", "studies")
-TOP_LEVEL = {"cli": "utilities", "rerun_log": "utilities", "rerun_blueprint": "utilities", "web_viewer": "utilities", "atomic_files": "utilities", "input_files": "utilities", "outputs": "utilities",
-             "parallel": "utilities", "progress": "utilities", "parsing": "utilities", "targets": "model", "physics": "physics", "quadruped_physics": "physics",
-             "scenes": "physics", "fingerprint": "physics", "robostrich": "domains",
-             "robostrich_a1": "domains", "gym_adapter": "domains", "policies": "domains",
-             "export_xml": "domains", "speed_benchmarks": "domains", "__init__": "domains"}
+# Each module's layer; a module may import from its own layer and the ones below it. The suite is
+# utilities to domains: it never imports the command kit or the studies.
+LAYERS = ("utilities", "model", "physics", "tasks", "domains", "commands", "studies")
+TOP_LEVEL = {"atomic_files": "utilities", "input_files": "utilities", "parsing": "utilities",
+             "targets": "model", "physics": "physics", "quadruped_physics": "physics", "scenes": "physics",
+             "fingerprint": "physics", "robostrich": "domains", "robostrich_a1": "domains",
+             "gym_adapter": "domains", "policies": "domains", "__init__": "domains",
+             "cli": "commands", "outputs": "commands", "progress": "commands", "parallel": "commands",
+             "web_viewer": "commands", "rerun_log": "commands", "rerun_blueprint": "commands",
+             "speed_benchmarks": "commands", "export_xml": "commands"}
 
 
 def layer_of(module: str) -> str:

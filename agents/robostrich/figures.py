@@ -7,9 +7,6 @@ tests can read what a reader sees); ``plot_learning_curves``, ``plot_track`` and
 import textwrap
 from typing import Dict, List
 
-import matplotlib
-import matplotlib.pyplot as plt
-import matplotlib.transforms as mtransforms
 import numpy as np
 
 from robostrich_suite import atomic_files
@@ -20,9 +17,13 @@ SUCCESS_LIMITS = (-0.03, 1.1)
 # How a figure names the runs of robostrich-train (its run directories' labels)
 RUN_NAMES = {"curriculum": "curriculum SAC", "baseline": "plain SAC (final lesson only)", "lookup": "lookup (no learning)"}
 
+
 def _subplots(*args, **kwargs):
     """``plt.subplots`` drawing into files (Agg), chosen at plot time: importing this module must
-    not switch a notebook's backend."""
+    not switch a notebook's backend. matplotlib is imported here, as the studies' figures do: a
+    command that draws nothing (--no-figures, a bad flag) starts without it."""
+    import matplotlib
+    import matplotlib.pyplot as plt
     matplotlib.use("Agg")
     return plt.subplots(*args, **kwargs)
 
@@ -41,6 +42,7 @@ def _smooth(x, n):
 
 
 def _save(fig, path: str) -> None:
+    import matplotlib.pyplot as plt
     atomic_files.save_figure(fig, path, dpi=110)
     plt.close(fig)
 
@@ -74,7 +76,7 @@ def _mark_lessons(axes, boundaries, names, last_step) -> None:
     for ax in axes:
         low, high = ax.get_ylim()
         ax.set_ylim(low, high + 0.08 * (high - low))  # headroom: names above the data
-        top = mtransforms.blended_transform_factory(ax.transData, ax.transAxes)
+        top = ax.get_xaxis_transform()  # x in data, y in axes units
         shown_left, shown_right = ax.get_xlim()
         for name, left, right in zip(names, edges[:-1], edges[1:]):
             left, right = max(left, shown_left), min(right, shown_right)  # centred on what shows

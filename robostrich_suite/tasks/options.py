@@ -4,7 +4,7 @@ the option.
 Options come from Python and from JSON (robostrich-train --task-kwargs), where a string or a
 list lands wherever a number or an object was meant: without these checks it surfaced as an
 AttributeError in the first episode, or as numpy's words without the option's name. Every
-number has a finite bound, as the commands' flags have (``robostrich_suite.cli``): a
+number has a finite bound, as the commands' flags have (``robostrich_suite.parsing``): a
 ``time_limit`` of 1e300 s is a typo, not an experiment.
 """
 from __future__ import annotations
@@ -14,13 +14,13 @@ import numbers
 
 import numpy as np
 
-from robostrich_suite import cli
+from robostrich_suite import parsing
 
-MAX_SECONDS = cli.MAX_SECONDS  # an episode, a settling or release time
+MAX_SECONDS = parsing.MAX_SECONDS  # an episode, a settling or release time
 MAX_SEED = 2**32 - 1  # numpy's RandomState takes seeds in [0, 2**32)
 MAX_WEIGHT = 1e6  # a reward weight: the defaults are 0.02 to 2
 MAX_SCALE = 10.0  # a domain-randomisation scale of a nominal parameter
-MAX_COUNT = cli.MAX_COUNT
+MAX_COUNT = parsing.MAX_COUNT
 
 
 def shown(value) -> str:
