@@ -180,6 +180,24 @@ def test_env_benchmark_resets_its_raw_baseline_like_the_environment(capsys, tmp_
         results_page.render_record(record)
 
 
+def test_a1_benchmark_says_where_an_env_step_goes(capsys, tmp_path):
+    """Each part dm_control calls is timed inside a real robostrich_a1 loop: the parts and the rest
+    add up to the step, the physics and the gait take time, and the record carries the shares."""
+    tool = load_tool("benchmark_a1")
+    actions = tool.speed_benchmarks.random_actions("robostrich_a1", "lesson4")
+    parts = tool.step_parts("lesson4", 200, actions)
+    assert list(parts) == [*tool.PARTS, "other"] and sum(parts.values()) == pytest.approx(1.0)
+    assert all(parts[p] > 0 for p in ("physics", "before_step (gait)", "observation", "reward"))
+    assert parts["physics"] > parts["reward"]  # four MuJoCo substeps cost more than one reward
+    report = tmp_path / "a1.json"
+    tool.main(["--steps", "100", "--repeats", "1", "--json", str(report)])
+    out = capsys.readouterr().out
+    assert "where an env step's time goes: physics " in out
+    record = results_page.make_record("speed_a1", str(report), "Speed", date="2026-12-07")
+    shares = {row["what"] for row in record["data"]["ratios"]}
+    assert {f"share of an env step: {p}" for p in parts} <= shares
+
+
 def test_learner_benchmark_reports_its_ratios_against_plain_versions(tmp_path, tool_env):
     """At a tiny size: the fused update and the acting loop against their plain versions, printed
     and written as a speed record (ratios, not judged: any value can come out on a busy machine)."""

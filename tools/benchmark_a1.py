@@ -11,9 +11,13 @@ All runs use the same MJCF and the same 4 physics substeps per control step:
 
 The printed ratios are the cost of the wrapper (env/raw) and of the gait alone.  The
 CPU is shared, so the three are run interleaved ``--repeats`` times and the best
-rate of each is kept.
+rate of each is kept.  Then where an env step's time goes, so that the next lever shows:
+one more env loop with a timer around each part dm_control calls (the physics' substeps,
+the task's ``before_step``, which sets the gait's leg targets, its ``after_step``, the
+observation and the reward), the rest being dm_control's own step and the resets.
 """
 import argparse
+import collections
 import os
 import sys
 import time
@@ -53,6 +57,31 @@ def raw_steps_per_second(steps: int, actions: np.ndarray, with_gait: bool = Fals
     return steps / (time.perf_counter() - start)
 
 
+PARTS = {"physics": ("physics", "step"), "before_step (gait)": ("task", "before_step"),
+         "after_step": ("task", "after_step"), "observation": ("task", "get_observation"),
+         "reward": ("task", "get_reward")}
+
+
+def step_parts(task: str, steps: int, actions: np.ndarray) -> dict:
+    """Share of an env step's time per part (PARTS, then "other": dm_control's step and the resets)."""
+    loop = speed_benchmarks.EnvLoop("robostrich_a1", task, actions)
+    seconds = collections.Counter()
+    for part, (owner, method) in PARTS.items():
+        instance = loop.env.physics if owner == "physics" else loop.env.task
+        original = getattr(instance, method)
+
+        def timed(*args, _original=original, _part=part, **kwargs):
+            start = time.perf_counter()
+            try:
+                return _original(*args, **kwargs)
+            finally:
+                seconds[_part] += time.perf_counter() - start
+        setattr(instance, method, timed)  # dm_control looks the method up on the instance
+    total = loop.run(steps)
+    shares = {part: seconds[part] / total for part in PARTS}
+    return {**shares, "other": 1.0 - sum(shares.values())}
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0], allow_abbrev=False)
     parser.add_argument("--steps", type=int, default=2000, help="control steps per loop and repeat")
@@ -73,6 +102,8 @@ def main(argv=None):
           f"(including resets every {quadruped_tasks.LESSON4_TIME_LIMIT:g} s)")
     print(f"ratio env/raw         : {wrapped / raw:10.3f}")
     print(f"ratio (raw+gait)/raw  : {raw_gait / raw:10.3f}")
+    parts = step_parts(args.task, args.steps, actions)
+    print("where an env step's time goes: " + ", ".join(f"{part} {share:.0%}" for part, share in parts.items()))
     if args.json:
         speed_benchmarks.write_report(
             args.json, __file__, argv if argv is not None else sys.argv[1:],
@@ -82,7 +113,8 @@ def main(argv=None):
              speed_benchmarks.rate("raw mj_step x4 + the gait's joint targets", raw_gait, "control steps/s"),
              speed_benchmarks.rate(f"robostrich_a1/{args.task}", wrapped, "control steps/s")],
             [speed_benchmarks.ratio(f"robostrich_a1/{args.task} / raw mj_step", wrapped / raw),
-             speed_benchmarks.ratio("raw + gait / raw mj_step", raw_gait / raw)])
+             speed_benchmarks.ratio("raw + gait / raw mj_step", raw_gait / raw),
+             *(speed_benchmarks.ratio(f"share of an env step: {part}", share) for part, share in parts.items())])
         print(f"wrote {args.json}")
 
 
