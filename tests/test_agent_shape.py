@@ -1,5 +1,6 @@
 """The code's shape: generic modules that name no robot, no function longer than a screen, no module
-over 500 lines, and checkpoints that say which format they are."""
+over 500 lines. (How a checkpoint of an earlier format is read: tests/test_run_spec.py and
+tests/test_learner_layout.py.)"""
 import ast
 import pathlib
 import re
@@ -37,14 +38,3 @@ def test_no_module_is_longer_than_its_one_job_needs():
     long = [f"{path.relative_to(ROOT)}: {n} lines" for path in PROJECT_MODULES
             if (n := len(path.read_text().splitlines())) > MAX_MODULE_LINES]
     assert not long, "\n".join(long)
-
-
-def test_no_legacy_shims_remain():
-    """Older checkpoints are refused by their format version, not translated: no code for them."""
-    hits = []
-    for path in PROJECT_MODULES:
-        for n, line in enumerate(path.read_text().splitlines(), 1):
-            # dm_control's own `legacy_step` attribute is its API, not ours
-            if "legacy" in line.lower() and "legacy_step" not in line and "legacy step" not in line:
-                hits.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
-    assert not hits, "\n".join(hits)
