@@ -1,8 +1,9 @@
 """Console-script wrapper: exit status and one-line errors for the `robostrich-*` commands.
 
 Every module with a command keeps `main(argv)` returning its results (for
-Python callers and tests) and offers `cli(argv)`, the console-script entry
-point in setup.py, which calls `run(main, prog, argv)`:
+Python callers and tests) and offers `cli(argv)`, the entry point that the
+console scripts' table (robostrich_commands.py) names, which calls
+`run(main, prog, argv)`:
 
     0    success (whatever `main` returned)
     2    an expected user error: ValueError (bad values, damaged or mismatched

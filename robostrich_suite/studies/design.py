@@ -7,7 +7,7 @@ The space is :mod:`robostrich_suite.studies.design_space` (Table 1's links, one 
 ventral tendons through run-through holes; origins, insertions and hole offsets searched).
 Each trial is scored cheaply (:mod:`robostrich_suite.studies.design_objectives`, ``--pose-budget``).
 
-**Beyond the paper's family** (2026-12-05): ``--ventral-tendons N`` (2-16) and ``--dorsal-tendons M``
+**Beyond the paper's family**: ``--ventral-tendons N`` (2-16) and ``--dorsal-tendons M``
 (1-4) change the tendon counts, and ``--max-hole-stride K`` (1-4) lets each tendon's holes be up to
 K links apart, skipping the links between (``design_space.Space``: the one other insertion the
 generator builds as it is; a tendon tied at two links short of the base is already in the family).
@@ -22,8 +22,8 @@ test the paper's arm passes, not a quantity to trade, so it bounds the search in
 spreading the front over a third axis; coverage and the gap column do trade (a neck that rises
 under its head reaches less of the region in front), and the front shows how.
 
-**The slot where the task puts it, and the way in** (2026-12-04, docs/layouts.md).  The first
-search found its columns over the mount, and no ramp from under the shelf got into any of them.
+**The slot where the task puts it, and the way in** (docs/layouts.md).  Left free, the search
+finds its columns over the mount, where no ramp from under the shelf gets in.
 ``--slot-x MIN,MAX`` holds the slot's centre in that range (m ahead of the base joint; the task's
 is ``gap_column.TASK_NEED["slot_x_m"]``, 0.36 m); ``--score-passage`` replaces the second objective
 by the way in (``design_objectives.passage_score``): how far up through the slot the head gets
