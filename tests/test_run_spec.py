@@ -69,6 +69,17 @@ def test_each_older_format_reads_as_the_run_that_wrote_it_in_every_reader(writte
     assert source.fingerprint["config"] == spec.config.to_dict()
 
 
+def test_a_config_written_before_fine_inputs_reads_as_none_and_no_other(written, tmp_path):
+    """A stored config without fine_input_gain computed what 0 computes: a run with fine inputs is
+    another run."""
+    spec, path = written
+    older = _older(path, tmp_path, "older.ckpt", OLDER_FORMATS["before fine inputs (2026-12-05)"])
+    for changed in ({"fine_input_gain": 30.0}, {"fine_inputs": ("to_target=30",)}):
+        other = dataclasses.replace(spec, config=dataclasses.replace(spec.config, **changed))
+        with pytest.raises(checkpoint.CheckpointError):
+            DomainRun(other, str(tmp_path / "other")).restore(older)
+
+
 def test_her_level_goals_on_reads_as_the_task_option_it_became(written, tmp_path):
     spec, path = written
     on = _older(path, tmp_path, "on.ckpt", lambda fp: {**fp, "config": {**fp["config"], "her_level_goals": True}})
@@ -76,7 +87,12 @@ def test_her_level_goals_on_reads_as_the_task_option_it_became(written, tmp_path
     assert became == dataclasses.replace(spec, task_kwargs={**spec.task_kwargs, "hindsight_level_goals": True})
     with pytest.raises(checkpoint.CheckpointError, match="hindsight_level_goals"):
         DomainRun(spec, str(tmp_path / "other")).restore(on)
-    DomainRun(became, str(tmp_path / "same")).restore(on)
+    same = DomainRun(became, str(tmp_path / "same"))
+    same.restore(on)
+    assert same.loop.env.task.hindsight_level_goals and same.loop.env_steps == 60
+    assert evaluation.load_run_from_checkpoint(on).spec == became
+    with pytest.raises(ValueError, match="her_level_goals"):  # a config of today's has no such field
+        SACConfig.from_dict({**spec.config.to_dict(), "her_level_goals": True})
 
 
 @pytest.mark.parametrize("kind", ["mlp", "layer_norm"])
