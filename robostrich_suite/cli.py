@@ -89,19 +89,20 @@ def raise_if_interrupted() -> None:
 
 def _on_sigint(signum, frame):
     """Ctrl-C or SIGTERM: a KeyboardInterrupt now, or a flag for the loop inside `deferred_interrupts`;
-    only the flag inside a garbage-collection callback (JAX's), where Python would print the
-    exception as ignored and go on: the next `raise_if_interrupted` acts on it."""
+    only the flag where Python would print the exception as ignored and go on (a garbage-collection
+    callback, JAX's; an object's finaliser, Rerun's recording stream): the next
+    `raise_if_interrupted`, or the end of `run`, acts on it."""
     global _interrupted, _signal
     _interrupted, _signal = True, signum
-    if not _deferred and not _in_gc_callback(frame):
+    if not _deferred and not _where_exceptions_are_ignored(frame):
         raise KeyboardInterrupt
 
 
-def _in_gc_callback(frame) -> bool:
-    """Whether ``frame`` runs inside one of ``gc.callbacks``."""
+def _where_exceptions_are_ignored(frame) -> bool:
+    """Whether ``frame`` runs inside one of ``gc.callbacks`` or a ``__del__`` method."""
     codes = {getattr(callback, "__code__", None) for callback in gc.callbacks}
     while frame is not None:
-        if frame.f_code in codes:
+        if frame.f_code in codes or frame.f_code.co_name == "__del__":
             return True
         frame = frame.f_back
     return False

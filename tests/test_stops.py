@@ -182,28 +182,44 @@ def test_a_command_stopped_mid_recording_leaves_no_recording(tmp_path):
         assert not out.exists() or os.listdir(out) == [], os.listdir(out)
 
 
-GC_CALLBACK_STOP = """
-import gc, signal
-from robostrich_suite import cli
-cli._install(cli._on_sigint)
-def callback(phase, info):  # as JAX's: Python runs it from the collector and ignores what it raises
-    if phase == "start":
-        signal.raise_signal(signal.SIGINT)
-gc.callbacks.append(callback)
-gc.collect()
-gc.callbacks.remove(callback)
+ACTED_ON = """
 print("interrupted", cli.interrupted())
 try:
     cli.raise_if_interrupted()
 except KeyboardInterrupt:
     print("acted on")
 """
+# Python runs both from wherever the program happens to be, and prints what they raise as ignored.
+STOP_WHERE_EXCEPTIONS_ARE_IGNORED = {
+    "gc callback": """
+import gc, signal
+from robostrich_suite import cli
+cli._install(cli._on_sigint)
+def callback(phase, info):  # as JAX's
+    if phase == "start":
+        signal.raise_signal(signal.SIGINT)
+gc.callbacks.append(callback)
+gc.collect()
+gc.callbacks.remove(callback)
+""" + ACTED_ON,
+    "finaliser": """
+import signal
+from robostrich_suite import cli
+cli._install(cli._on_sigint)
+class Stream:  # as Rerun's RecordingStream, which flushes when its last reference goes
+    def __del__(self):
+        signal.raise_signal(signal.SIGINT)
+Stream()
+""" + ACTED_ON}
 
 
-def test_ctrl_c_inside_a_garbage_collection_callback_is_kept_for_the_loop_not_printed_as_ignored():
-    """Ctrl-C landing in a gc callback (JAX registers one) only sets the flag: raised there,
-    Python would print 'Exception ignored in ...' above the command's one line."""
-    result = subprocess.run([sys.executable, "-c", GC_CALLBACK_STOP], capture_output=True, text=True, timeout=120)
+@pytest.mark.parametrize("where", sorted(STOP_WHERE_EXCEPTIONS_ARE_IGNORED))
+def test_ctrl_c_where_python_ignores_exceptions_is_kept_for_the_loop_not_printed_as_ignored(where):
+    """Ctrl-C landing in a gc callback (JAX registers one) or in an object's finaliser (Rerun's
+    recording stream has one) only sets the flag: raised there, Python would print 'Exception
+    ignored in ...' above the command's one line."""
+    result = subprocess.run([sys.executable, "-c", STOP_WHERE_EXCEPTIONS_ARE_IGNORED[where]], capture_output=True,
+                            text=True, timeout=120)
     assert result.returncode == 0, result.stderr[-3000:]
     assert result.stdout.split("\n")[:2] == ["interrupted True", "acted on"], result.stdout
     assert "Exception ignored" not in result.stderr, result.stderr[-3000:]
