@@ -65,7 +65,7 @@ _FACTORY.add_lessons(SUITE, ", with the quadruped standing.")
 targets_from_frame = tasks.frame_to_trunk
 
 
-@SUITE.add(lessons.CURRICULUM, lessons.DRAWS_TARGETS)
+@SUITE.add(lessons.CURRICULUM, lessons.DRAWS_TARGETS, lessons.WALKING)
 def lesson4(time_limit=tasks.LESSON4_TIME_LIMIT, random=None, environment_kwargs=None,
             arm_spec=None, tendon_layout=None, height_range=tasks.LESSON4_HEIGHT_RANGE,
             **task_kwargs):

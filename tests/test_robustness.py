@@ -2,7 +2,6 @@
 measured by robostrich-robustness: real MuJoCo, small sizes."""
 import dataclasses
 import json
-import os
 
 import numpy as np
 import pytest
@@ -142,6 +141,19 @@ def test_the_quadruped_families_move_the_trunk_and_the_gait_clock():
     walking = _env(Perturbation(gait_timing=0.5), domain="robostrich_a1", task="lesson4")
     walking.reset()
     assert walking.task.randomizer.gait_rate != 1.0 and walking.task.randomizer.gait_phase > 0
+
+
+def test_on_the_quadruped_the_gaits_timing_is_judged_while_it_walks():
+    """Standing, the gait's clock changes nothing the arm feels; the walking evaluation (lesson 4,
+    the quadruped trotting) is where gait_timing shows, so robostrich-robustness judges it there too."""
+    from agents.robostrich.robustness import command as robustness
+    evaluated = robustness.load_evaluated("robostrich_a1", "policy")
+    nominal, late = (robustness.evaluate(evaluated, perturbation, num_targets=1)
+                     for perturbation in (Perturbation(), Perturbation(gait_timing=0.5)))
+    assert set(nominal) == {"heldout", "heldout_moving", "walking"} and nominal["walking"]["episodes"] == 1
+    assert late["heldout"] == nominal["heldout"] and late["heldout_moving"] == nominal["heldout_moving"]
+    assert late["walking"]["position_error_median"] != nominal["walking"]["position_error_median"]
+    assert "walking" not in robustness.evaluate(robustness.load_evaluated("robostrich", "policy"), Perturbation(), 1)
 
 
 def test_a_bad_scale_names_the_family():

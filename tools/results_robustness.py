@@ -2,7 +2,7 @@
 (robostrich-robustness's robustness.json; what scale s means per family:
 robostrich_suite/tasks/perturbations.py)."""
 
-KINDS = {"heldout": "fixed start", "heldout_moving": "moving starts"}
+from agents.robostrich.robustness.figure import KINDS
 
 
 def read(data: dict, path: str) -> tuple:
@@ -12,9 +12,10 @@ def read(data: dict, path: str) -> tuple:
 
 
 def caption(data: dict) -> str:
+    first = next(iter(data["results"][data["labels"][0]].values()))[0]
     return (f"held-out success (%) of {data['policy']} on {data['domain']}, {data['num_targets']} held-out targets, "
             f"as each family of differences (robostrich_suite/tasks/perturbations.py) grows to scale s, then all "
-            f"at once; fixed start / moving starts")
+            f"at once; " + " / ".join(words for kind, words in KINDS.items() if kind in first))
 
 
 def _cell(row: dict) -> str:

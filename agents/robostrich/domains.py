@@ -144,6 +144,11 @@ class Domain:
         return bool(self.tagged(lessons.MOVING_START))
 
     @property
+    def walking_task(self) -> Optional[str]:
+        """The task whose held-out targets are reached while the legs walk (the quadruped's lesson 4), else None."""
+        return next(iter(self.tagged(lessons.WALKING)), None)
+
+    @property
     def moving_start_task(self) -> str:
         """The task whose episodes continue from where the last ended (moving starts)."""
         return self.tagged(lessons.MOVING_START)[0]

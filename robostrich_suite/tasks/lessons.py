@@ -34,6 +34,7 @@ HELDOUT = "heldout"  # held-out targets are judged here: eq. 10 from the fixed s
 MOVING_START = "moving_start"  # each episode continues from where the last ended
 TRACK = "track"  # several targets in turn (Fig. 7)
 EVALUATION = "evaluation"  # an evaluation of its own, not a lesson
+WALKING = "walking"  # held-out targets judged while the legs walk (what the robot's walk does to the arm)
 # the tags of each lesson beside CURRICULUM and DRAWS_TARGETS
 LESSON_TAGS = {"lesson1": (), "lesson2": (HELDOUT,), "lesson3": (MOVING_START,)}
 
