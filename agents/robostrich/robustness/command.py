@@ -8,7 +8,7 @@ perturbed robot; the lookup baseline beside the policy, a second policy optional
 meets the same robots: the draws come from the evaluation's seeds, not from the policy.
 Writes robustness.json (a results record, tools/results_robustness.py) and robustness.png.
 On the quadruped the held-out targets are also judged while it walks (its lesson 4, the trunk
-height changing): standing, the gait's timing and the trunk's height change nothing the arm feels.
+height changing): standing, the gait's timing has nothing to act on.
 """
 import argparse
 import dataclasses

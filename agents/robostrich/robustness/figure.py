@@ -1,6 +1,7 @@
 """The figure of `robostrich-robustness`: success against scale s, a line per family, one column
 per evaluated policy (the policy, a compared one, the lookup) and one row per evaluation (fixed
-start, moving starts, and on the quadruped while it walks), so the policy and the baseline sit side by side on the same axes' scale."""
+start, moving starts, and on the quadruped while it walks), so the policy and the baseline sit side
+by side on the same axes' scale."""
 import matplotlib
 import matplotlib.pyplot as plt
 
