@@ -16,7 +16,7 @@ setup(
     packages=find_packages(include=["robostrich_suite", "robostrich_suite.*", "agents", "agents.*"]),
     # robostrich_commands.py: the console scripts' light launcher, beside the packages (its docstring says why)
     py_modules=["robostrich_commands"],
-    package_data={"robostrich_suite": ["data/*", "data/policies/*", "data/new_targets/*", "data/help/*"]},
+    package_data={"robostrich_suite": ["data/*", "data/policies/*", "data/new_targets/*", "data/help/*", "data/arms/*"]},
     install_requires=[
         "mujoco==3.17.0",
         "dm-control==1.0.50",
