@@ -1,6 +1,7 @@
 """An arm described in a file (robostrich_suite/model/arm_file.py): Table 1's file is Table 1's arm
 and writes the checked-in models; a changed field reaches the model; a file that cannot be an arm is
 one line naming the field, exit status 2."""
+import os
 import re
 
 import pytest
@@ -46,7 +47,9 @@ def test_the_command_writes_an_arms_models_and_refuses_a_bad_file_in_one_line(tm
         "routing": (_with(tmp_path, "f", r'^layout = "ventral_slips"', 'file = "routing.toml"'),
                     "routing.file: 'routing.toml' does not fit this arm"),
         "not toml": (_with(tmp_path, "g", r"^\[arm\]", "[arm"), "not valid TOML"),
+        "fifo": (tmp_path / "fifo.toml", "a FIFO, not a text file"),  # refused at once, never waited on
     }
+    os.mkfifo(tmp_path / "fifo.toml")
     cases = {"stiff": ("robostrich-export-xml", ["--arm", stiff, "--out", tmp_path / "xml"]),
              "table1": ("robostrich-export-xml", ["--arm", TABLE1, "--out", tmp_path / "table1"])}
     cases.update({name: ("robostrich-export-xml", ["--arm", path, "--out", tmp_path / name.replace(" ", "_")])

@@ -19,13 +19,12 @@ from __future__ import annotations
 import dataclasses
 import json
 import pathlib
-import tomllib
 
+from robostrich_suite import parsing
 from robostrich_suite.model import arm as arm_lib
 from robostrich_suite.model import layouts
 
 SHIPPED_DIR = pathlib.Path(__file__).resolve().parents[1] / "data" / "arms"
-MAX_FILE_BYTES = 1_000_000  # an arm file is a few kB
 # The unit of each ArmSpec field, as the written file's comments give it.
 UNITS = {"joint_names": "head first, base last", "dorsal_limits_deg": "deg, magnitudes in [0, 180)",
          "ventral_limits_deg": "deg, magnitudes in [0, 180)", "link_lengths": "m, for joint_names[1:]",
@@ -67,14 +66,12 @@ def read(path) -> ArmFile:
 
 
 def _load(path: pathlib.Path) -> dict:
-    if path.stat().st_size > MAX_FILE_BYTES:  # a missing file is an OSError naming it
-        raise ArmFileError(f"{path}: {path.stat().st_size} bytes, more than an arm file's {MAX_FILE_BYTES}")
+    """The file's TOML (parsing.read_toml: a FIFO or a device is refused at once, not read); a
+    missing file is the OSError naming it."""
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError as error:
-        raise ArmFileError(f"{path}: not a UTF-8 text file (byte {error.start} cannot be decoded)") from None
-    except tomllib.TOMLDecodeError as error:
-        raise ArmFileError(f"{path}: not valid TOML: {error}") from None
+        return parsing.read_toml(path)
+    except ValueError as error:  # not a regular file, too large, not UTF-8 or not TOML: the message names the file
+        raise ArmFileError(str(error)) from None
 
 
 def _failer(path: pathlib.Path):
