@@ -102,6 +102,9 @@ def test_malformed_toml_and_unknown_file_types_are_named(tmp_path):
         layouts.read_file(yaml)
     with pytest.raises(OSError):
         layouts.read_file(tmp_path / "missing.json")
+    os.mkfifo(tmp_path / "fifo.toml")  # refused at once: reading it would wait for a writer
+    with pytest.raises(layouts.LayoutFileError, match="fifo.toml: a FIFO, not a layout file"):
+        layouts.read_file(tmp_path / "fifo.toml")
     with pytest.raises(ValueError, match="unknown layout 'best'"):
         layouts.build("best")
 

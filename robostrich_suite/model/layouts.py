@@ -41,7 +41,7 @@ import pathlib
 from typing import Callable
 
 from robostrich_suite.model import arm as arm_lib
-from robostrich_suite import targets
+from robostrich_suite import input_files, targets
 
 MAX_TENDONS = 9  # the paper's 9 servos: the built-ins compare at the same actuation budget
 # A layout file may have more (robostrich-design's searches beyond the paper's family write them,
@@ -284,12 +284,12 @@ def read_file(path, spec: arm_lib.ArmSpec | None = None) -> tuple[str, arm_lib.T
     """``(name, layout)`` from a ``.json`` or ``.toml`` file; the name defaults to the
     file's stem."""
     path = pathlib.Path(path)
-    if path.stat().st_size > MAX_FILE_BYTES:  # a missing file is an OSError naming it
-        raise LayoutFileError(f"{path}: {path.stat().st_size} bytes, more than a layout file's {MAX_FILE_BYTES}")
-    try:
-        text = path.read_text(encoding="utf-8")
+    try:  # a regular file of bounded size, a FIFO refused at once (not waited on); a missing one: OSError
+        text = input_files.read_bytes(path, MAX_FILE_BYTES, "layout file").decode("utf-8")
     except UnicodeDecodeError as error:
         raise LayoutFileError(f"{path}: not a UTF-8 text file (byte {error.start} cannot be decoded)") from None
+    except ValueError as error:  # not a regular file, or too large
+        raise LayoutFileError(str(error)) from None
     suffix = path.suffix.lower()
     try:
         if suffix == ".json":
