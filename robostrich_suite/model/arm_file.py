@@ -1,7 +1,7 @@
 """An arm described in a file: every field of :class:`~robostrich_suite.model.arm.ArmSpec` and its
 routing, in TOML, so that a researcher's own tendon arm needs no Python.
 
-The schema (``robostrich_suite/data/arms/robostrich.toml`` is Table 1's arm written by :func:`write`)::
+The schema (``robostrich_suite/data/arms/robostrich.toml`` is Table 1's arm written by :func:`text`)::
 
     name = "robostrich"              # the arm's name (its MJCF files are named after it)
     [arm]                            # ArmSpec's fields in SI units (``UNITS``), sequences head first;
